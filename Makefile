@@ -1,0 +1,30 @@
+# The README's two commands: `make demo` (install, fly a Lynx campaign, plot its ellipses) and
+# `make test` (install, run the tests). Both create the virtual environment they need.
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+N ?= 1000
+
+.PHONY: install demo test bench clean
+
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test]"
+	touch $@
+
+install: $(VENV)/.installed
+
+demo: install
+	mkdir -p results
+	$(VENV)/bin/rocketmc run campaigns/lynx_nominal.toml -n $(N) --out results/lynx_nominal.h5
+	$(VENV)/bin/rocketmc report results/lynx_nominal.h5 --plot results/lynx_nominal_ellipses.png
+
+test: install
+	$(PY) -m pytest -n 2 -q
+
+bench: install
+	$(PY) benchmarks/throughput.py
+
+clean:
+	rm -rf results .pytest_cache

@@ -1,0 +1,21 @@
+"""rocketmc: a JAX Monte Carlo dispersion engine for sounding rockets with canard control.
+
+Importing rocketmc sets two JAX options (docs/sharp-bits.md):
+- float64 (``jax_enable_x64``): minutes of flight integrated in thousands of steps, and
+  bit-reproducible campaigns, want it;
+- one XLA CPU device per core (``--xla_force_host_platform_device_count``), unless XLA_FLAGS
+  already chooses, so a campaign chunk runs on every core. It only takes effect if JAX's backend
+  has not started yet.
+"""
+
+import os
+
+if "xla_force_host_platform_device_count" not in os.environ.get("XLA_FLAGS", ""):
+    _cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} --xla_force_host_platform_device_count={_cores}".strip()
+
+import jax  # noqa: E402
+
+jax.config.update("jax_enable_x64", True)
+
+__version__ = "0.1.0"

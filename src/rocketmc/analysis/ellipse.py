@@ -1,0 +1,116 @@
+"""Confidence ellipses of impact points (north/east in metres from the pad, NED world frame)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+
+def chi2_scale(level: float) -> float:
+    """Squared Mahalanobis radius k^2 enclosing ``level`` of a 2-D normal: ``chi2.ppf(level, 2)``.
+
+    For two degrees of freedom this equals ``-2 ln(1 - level)``.
+    """
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"confidence level must lie strictly between 0 and 1, got {level}")
+    return float(chi2.ppf(level, df=2))
+
+
+@dataclass(frozen=True)
+class Ellipse:
+    """Confidence ellipse in the horizontal plane.
+
+    Centre and semi-axes in metres (north/east from the pad); ``orientation_deg`` is the azimuth
+    of the major axis, clockwise from north, in [0, 180); ``n`` the number of points used.
+    """
+
+    level: float
+    center_north_m: float
+    center_east_m: float
+    semi_major_m: float
+    semi_minor_m: float
+    orientation_deg: float
+    n: int
+
+    @property
+    def area_m2(self) -> float:
+        """Area pi*a*b [m^2]."""
+        return float(np.pi * self.semi_major_m * self.semi_minor_m)
+
+    def to_dict(self) -> dict:
+        """Plain JSON-serialisable dict of the fields plus ``area_m2``."""
+        return {**asdict(self), "area_m2": self.area_m2}
+
+    def _axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Unit vectors (north, east) of the major and minor axes."""
+        az = np.deg2rad(self.orientation_deg)
+        return np.array([np.cos(az), np.sin(az)]), np.array([-np.sin(az), np.cos(az)])
+
+    def boundary(self, n_points: int = 200) -> tuple[np.ndarray, np.ndarray]:
+        """Closed outline as ``(north, east)`` arrays [m] of ``n_points`` (first = last point)."""
+        t = np.linspace(0.0, 2.0 * np.pi, n_points)
+        major, minor = self._axes()
+        a = self.semi_major_m * np.cos(t)
+        b = self.semi_minor_m * np.sin(t)
+        north = self.center_north_m + a * major[0] + b * minor[0]
+        east = self.center_east_m + a * major[1] + b * minor[1]
+        return north, east
+
+    def contains(self, north, east) -> np.ndarray:
+        """Boolean array: which points (north, east) [m] lie inside or on the ellipse.
+
+        A degenerate (zero-width) axis only admits points exactly on it.
+        """
+        dn = np.asarray(north, dtype=float) - self.center_north_m
+        de = np.asarray(east, dtype=float) - self.center_east_m
+        major, minor = self._axes()
+        x = dn * major[0] + de * major[1]
+        y = dn * minor[0] + de * minor[1]
+        return _normalised_sq(x, self.semi_major_m) + _normalised_sq(y, self.semi_minor_m) <= 1.0
+
+
+def _normalised_sq(x: np.ndarray, semi_axis: float) -> np.ndarray:
+    """(x / semi_axis)^2, with 0/0 = 0 and x/0 = inf."""
+    if semi_axis > 0.0:
+        return (x / semi_axis) ** 2
+    return np.where(x == 0.0, 0.0, np.inf)
+
+
+def confidence_ellipse(north, east, level: float = 0.95) -> Ellipse:
+    """Ellipse expected to hold ``level`` of the impact points, assuming they are 2-D normal.
+
+    ``north``, ``east``: impact coordinates [m] from the pad (NED). Pairs with a non-finite
+    coordinate (failed realizations) are ignored. Uses the sample mean and sample covariance
+    (ddof=1) scaled by k^2 = ``chi2.ppf(level, df=2)``: semi-axes are sqrt(k^2 * eigenvalues).
+    """
+    north = np.asarray(north, dtype=float).ravel()
+    east = np.asarray(east, dtype=float).ravel()
+    if north.shape != east.shape:
+        raise ValueError(f"north and east differ in length: {north.size} vs {east.size}")
+    k2 = chi2_scale(level)
+    finite = np.isfinite(north) & np.isfinite(east)
+    n = int(finite.sum())
+    if n < 3:
+        raise ValueError(
+            f"a confidence ellipse needs at least 3 finite (north, east) points, got {n} "
+            f"of {north.size}"
+        )
+    points = np.stack([north[finite], east[finite]])
+    center = points.mean(axis=1)
+    eigval, eigvec = np.linalg.eigh(np.cov(points, ddof=1))  # ascending eigenvalues
+    eigval = np.clip(eigval, 0.0, None)  # round-off can make a zero eigenvalue slightly negative
+    major = eigvec[:, 1]
+    orientation = float(np.degrees(np.arctan2(major[1], major[0])) % 180.0)
+    if orientation >= 180.0:  # -tiny % 180 rounds to 180.0
+        orientation = 0.0
+    return Ellipse(
+        level=float(level),
+        center_north_m=float(center[0]),
+        center_east_m=float(center[1]),
+        semi_major_m=float(np.sqrt(k2 * eigval[1])),
+        semi_minor_m=float(np.sqrt(k2 * eigval[0])),
+        orientation_deg=orientation,
+        n=n,
+    )

@@ -1,0 +1,267 @@
+"""Reading campaign result files (HDF5) and summarising them.
+
+Layout read here: ``/outputs/<name>`` 1-D datasets (row = realization, ``attrs["unit"]``),
+``/outputs/status`` int (0 = ok, ``attrs["codes"]`` a JSON object code -> message),
+``/inputs/<name>`` 1-D sampled dispersions, and root attributes such as ``campaign_name``,
+``seed``, ``n_realizations`` and ``complete``. Impact points are north/east [m] from the pad
+(NED world frame).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+
+from .ellipse import confidence_ellipse
+
+SUMMARY_LEVELS = (0.5, 0.95, 0.99)
+"""Confidence levels of the impact ellipses in :func:`summarize`."""
+
+_PERCENTILES = {"p5": 5.0, "p50": 50.0, "p95": 95.0}
+
+
+@dataclass(frozen=True)
+class Run:
+    """A loaded campaign: outputs and inputs per realization, root attributes, units
+    (dataset name -> unit string) and status codes (code -> message)."""
+
+    outputs: pd.DataFrame
+    inputs: pd.DataFrame
+    attrs: dict
+    units: dict[str, str]
+    status_codes: dict[int, str]
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask of realizations with status 0."""
+        if "status" not in self.outputs:
+            raise ValueError("result file has no /outputs/status dataset")
+        return self.outputs["status"].to_numpy() == 0
+
+    def ok_impacts(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(north, east)`` impact points [m] of ok realizations with finite coordinates."""
+        north = self.outputs["impact_north_m"].to_numpy(dtype=float)[self.ok]
+        east = self.outputs["impact_east_m"].to_numpy(dtype=float)[self.ok]
+        finite = np.isfinite(north) & np.isfinite(east)
+        return north[finite], east[finite]
+
+
+def _native(value):
+    """HDF5 attribute value as a plain Python (JSON-serialisable) object."""
+    if isinstance(value, bytes):
+        return value.decode()
+    if isinstance(value, np.ndarray):
+        return [_native(v) for v in value.tolist()]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _checked(f: h5py.File, path) -> None:
+    """Raise ValueError unless ``f`` is a complete rocketmc result file."""
+    if not isinstance(f.get("outputs"), h5py.Group):
+        raise ValueError(f"{path}: not a rocketmc result file (no /outputs group)")
+    if not bool(f.attrs.get("complete", False)):
+        raise ValueError(f"{path}: result file is incomplete (run still in progress or aborted)")
+
+
+def _read_group(f: h5py.File, name: str, path) -> tuple[pd.DataFrame, dict[str, str]]:
+    """Every 1-D dataset of group ``name`` as DataFrame columns, plus their units."""
+    group = f.get(name)
+    if group is None:
+        return pd.DataFrame(index=pd.RangeIndex(0, name="realization")), {}
+    columns, units = {}, {}
+    for key, item in group.items():
+        if not isinstance(item, h5py.Dataset):
+            continue
+        if item.ndim != 1:
+            raise ValueError(f"{path}: /{name}/{key} is not 1-D (shape {item.shape})")
+        columns[key] = item[()]
+        if "unit" in item.attrs:
+            units[key] = _native(item.attrs["unit"])
+    lengths = {len(v) for v in columns.values()}
+    if len(lengths) > 1:
+        raise ValueError(f"{path}: datasets in /{name} differ in length: {sorted(lengths)}")
+    n = lengths.pop() if lengths else 0
+    return pd.DataFrame(columns, index=pd.RangeIndex(n, name="realization")), units
+
+
+def load_outputs(path: str | Path) -> pd.DataFrame:
+    """Per-realization outputs of a complete result file (one column per ``/outputs`` dataset)."""
+    with h5py.File(path, "r") as f:
+        _checked(f, path)
+        return _read_group(f, "outputs", path)[0]
+
+
+def load_inputs(path: str | Path) -> pd.DataFrame:
+    """Per-realization sampled dispersions of a complete result file (``/inputs`` datasets)."""
+    with h5py.File(path, "r") as f:
+        _checked(f, path)
+        return _read_group(f, "inputs", path)[0]
+
+
+def load_run(path: str | Path) -> Run:
+    """Outputs, inputs, root attributes, units and status codes of a complete result file."""
+    with h5py.File(path, "r") as f:
+        _checked(f, path)
+        outputs, units = _read_group(f, "outputs", path)
+        inputs, input_units = _read_group(f, "inputs", path)
+        attrs = {k: _native(v) for k, v in f.attrs.items()}
+        codes = {}
+        if "status" in f["outputs"] and "codes" in f["outputs/status"].attrs:
+            raw = json.loads(_native(f["outputs/status"].attrs["codes"]))
+            codes = {int(k): str(v) for k, v in raw.items()}
+    expected = attrs.get("n_realizations")
+    if expected is not None and len(outputs) != expected:
+        raise ValueError(f"{path}: {len(outputs)} output rows but n_realizations = {expected}")
+    if len(inputs.columns) and len(inputs) != len(outputs):
+        raise ValueError(f"{path}: {len(inputs)} input rows but {len(outputs)} output rows")
+    return Run(outputs, inputs, attrs, {**input_units, **units}, codes)
+
+
+def _stat(x: float) -> float | None:
+    """Float, with NaN/inf mapped to None (strict JSON has no NaN)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def _metric_stats(values: np.ndarray) -> dict:
+    """n, mean, std (ddof=1), min, p5, p50, p95, max of the finite values."""
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return {"n": 0, **{k: None for k in ("mean", "std", "min", *_PERCENTILES, "max")}}
+    stats = {
+        "n": int(values.size),
+        "mean": _stat(values.mean()),
+        "std": _stat(values.std(ddof=1)) if values.size > 1 else None,
+        "min": _stat(values.min()),
+    }
+    stats.update({k: _stat(np.percentile(values, q)) for k, q in _PERCENTILES.items()})
+    stats["max"] = _stat(values.max())
+    return stats
+
+
+def summarize(run: Run) -> dict:
+    """JSON-serialisable summary of a run.
+
+    Keys: ``campaign_name``, ``seed``, ``rocketmc_version``, ``n_realizations``, ``n_ok``,
+    ``status`` (list of code/message/count, every known code and any other code seen),
+    ``metrics`` (per output except status, over ok realizations and finite values: unit, n,
+    mean, std (ddof=1), min, p5, p50, p95, max) and ``impact_ellipses`` (``Ellipse.to_dict()``
+    at 50/95/99 % of the ok impact points; empty when fewer than 3 are available).
+    """
+    ok = run.ok
+    status = run.outputs["status"].to_numpy()
+    seen, counts = np.unique(status, return_counts=True)
+    count_of = dict(zip(seen.tolist(), counts.tolist()))
+    codes = sorted(set(run.status_codes) | set(count_of))
+    status_rows = [
+        {
+            "code": c,
+            "message": run.status_codes.get(c, "ok" if c == 0 else "unknown"),
+            "count": count_of.get(c, 0),
+        }
+        for c in codes
+    ]
+    metrics = {
+        name: {"unit": run.units.get(name, ""), **_metric_stats(col.to_numpy(dtype=float)[ok])}
+        for name, col in run.outputs.items()
+        if name != "status"
+    }
+    north, east = run.ok_impacts()
+    ellipses = (
+        [confidence_ellipse(north, east, level).to_dict() for level in SUMMARY_LEVELS]
+        if north.size >= 3
+        else []
+    )
+    return {
+        "campaign_name": run.attrs.get("campaign_name", ""),
+        "seed": run.attrs.get("seed"),
+        "rocketmc_version": run.attrs.get("rocketmc_version", ""),
+        "n_realizations": len(run.outputs),
+        "n_ok": int(ok.sum()),
+        "status": status_rows,
+        "metrics": metrics,
+        "impact_ellipses": ellipses,
+    }
+
+
+def _num(x: float | None) -> str:
+    """About four significant figures, fixed-point where readable."""
+    if x is None:
+        return "-"
+    ax = abs(x)
+    if ax >= 1e7 or 0.0 < ax < 1e-2:
+        return f"{x:.3e}"
+    if ax >= 1000.0:
+        return f"{x:.1f}"
+    if ax >= 10.0:
+        return f"{x:.2f}"
+    return f"{x:.3f}"
+
+
+def _table(header: list[str], rows: list[list[str]], align: str) -> list[str]:
+    """Aligned text table; ``align`` holds one "l" (left) or "r" (right) per column."""
+    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
+
+    def line(cells):
+        return "  " + "  ".join(
+            c.ljust(w) if a == "l" else c.rjust(w) for c, w, a in zip(cells, widths, align)
+        ).rstrip()
+
+    return [line(header), *(line(r) for r in rows)]
+
+
+def format_summary(summary: dict) -> str:
+    """Compact human-readable report of a :func:`summarize` dict."""
+    out = [
+        f"Campaign {summary['campaign_name']!r}  (seed {summary['seed']}, "
+        f"rocketmc {summary['rocketmc_version']})",
+        f"Realizations: {summary['n_realizations']} total, {summary['n_ok']} ok",
+        "",
+        "Status",
+        *_table(
+            ["code", "count", "message"],
+            [[str(s["code"]), str(s["count"]), s["message"]] for s in summary["status"]],
+            align="rrl",
+        ),
+        "",
+        "Metrics (ok realizations)",
+    ]
+    stat_keys = ["mean", "std", "min", *_PERCENTILES, "max"]
+    out += _table(
+        ["metric", "unit", "n", *stat_keys],
+        [
+            [name, m["unit"], str(m["n"]), *(_num(m[k]) for k in stat_keys)]
+            for name, m in summary["metrics"].items()
+        ],
+        align="ll" + "r" * (1 + len(stat_keys)),
+    )
+    out += ["", "Impact ellipses (north/east from pad)"]
+    if summary["impact_ellipses"]:
+        out += _table(
+            ["level", "N [m]", "E [m]", "a [m]", "b [m]", "az [deg]", "area [km^2]", "area [m^2]"],
+            [
+                [
+                    f"{100 * e['level']:g} %",
+                    f"{e['center_north_m']:.1f}",
+                    f"{e['center_east_m']:.1f}",
+                    f"{e['semi_major_m']:.1f}",
+                    f"{e['semi_minor_m']:.1f}",
+                    f"{e['orientation_deg']:.1f}",
+                    f"{e['area_m2'] / 1e6:.4g}",
+                    f"{e['area_m2']:.0f}",
+                ]
+                for e in summary["impact_ellipses"]
+            ],
+            align="r" * 8,
+        )
+        out.append("  (N, E: centre; a, b: semi-axes; az: major axis, clockwise from north)")
+    else:
+        out.append("  not available: fewer than 3 ok impact points")
+    return "\n".join(out)

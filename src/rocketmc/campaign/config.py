@@ -1,0 +1,351 @@
+"""Campaign files (TOML): schema, validation and loading, on the host.
+
+Errors are ``ConfigError`` with one line that names the field (dotted path), what was expected and
+what was found; the CLI prints it and exits with code 2.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
+from ..env.atmosphere import G0
+
+DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
+ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
+
+
+class ConfigError(ValueError):
+    """A campaign that cannot be flown; the message is one line naming the field."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+
+
+class MotorConfig(_Strict):
+    """Solid motor; positions are distances from the nose tip, positive aft [m]."""
+
+    thrust_curve: str = Field(description="RASP .eng or CSV (time s, thrust N); built-in name or path")
+    propellant_mass_kg: Positive
+    isp_s: Positive | None = Field(None, description="checked against the curve's impulse / propellant")
+    ignition_delay_s: NonNegative = 0.0
+    thrust_scale: Positive = 1.0
+    nozzle_m: float
+    grain_outer_diameter_m: Positive
+    grain_inner_diameter_m: NonNegative
+    grain_length_m: Positive
+    grain_center_m: float | None = Field(None, description="default: the grain ends at the nozzle exit")
+
+    @model_validator(mode="after")
+    def _core_inside_grain(self):
+        if self.grain_inner_diameter_m >= self.grain_outer_diameter_m:
+            raise ValueError("grain_inner_diameter_m must be smaller than grain_outer_diameter_m")
+        return self
+
+
+class LinearAeroConfig(_Strict):
+    """Linear aerodynamic coefficients (per rad) at the reference point; see aero/linear.py."""
+
+    reference_area_m2: Positive
+    reference_length_m: Positive
+    ca0_mach: list[NonNegative] = Field(min_length=2)
+    ca0: list[NonNegative] = Field(min_length=2)
+    drag_scale: Positive = 1.0
+    ca_u: list[float] = Field([0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4)
+    cn_alpha: float
+    cn_delta: float = 0.0
+    cm_alpha: float
+    cm_delta: float = 0.0
+    cl0: float = 0.0
+    cl_delta: float = 0.0
+    cy_r: float = 0.0
+    cn_q: float = 0.0
+    cl_p: float = Field(0.0, le=0)
+    cm_q: float = Field(0.0, le=0)
+
+    @model_validator(mode="after")
+    def _mach_table(self):
+        if len(self.ca0) != len(self.ca0_mach):
+            raise ValueError("ca0 and ca0_mach must have the same length")
+        if np.any(np.diff(self.ca0_mach) <= 0):
+            raise ValueError("ca0_mach must be strictly increasing")
+        return self
+
+
+class ParachuteConfig(_Strict):
+    """A canopy: opens at apogee, or at deploy_altitude_m above ground after apogee."""
+
+    name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    cd: Positive
+    area_m2: Positive
+    deploy_altitude_m: NonNegative | None = None
+    delay_s: NonNegative = 0.0
+    opening_time_s: NonNegative = 0.0
+    attach_m: float
+
+
+class RocketConfig(_Strict):
+    """The rocket; positions are distances from the nose tip, positive aft [m]."""
+
+    reference_point_m: float
+    dry_mass_kg: Positive
+    dry_cg_m: float
+    dry_inertia_kgm2: list[Positive] = Field(min_length=2, max_length=2, description="[axial, transverse]")
+    rear_lug_m: float
+    canopy_roll_damping: float = Field(-5.0, le=0)
+    motor: MotorConfig
+    aero: LinearAeroConfig
+    parachutes: list[ParachuteConfig] = []
+
+    @model_validator(mode="after")
+    def _unique_names(self):
+        names = [p.name for p in self.parachutes]
+        if len(set(names)) != len(names):
+            raise ValueError(f"parachute names must be unique, got {names}")
+        return self
+
+
+class SiteConfig(_Strict):
+    name: str = ""
+    latitude_deg: float = Field(ge=-90, le=90)
+    longitude_deg: float = Field(ge=-180, le=360)
+    altitude_m: float = Field(ge=-400, le=30000, description="pad altitude above mean sea level")
+
+
+class LaunchConfig(_Strict):
+    rail_length_m: Positive
+    elevation_deg: float = Field(gt=0, le=90, description="rail angle above the horizon")
+    azimuth_deg: float = Field(ge=-360, le=720, description="clockwise from north")
+
+
+class WindLayerConfig(_Strict):
+    speed_mps: NonNegative
+    from_deg: float = Field(ge=-360, le=720, description="direction the wind blows from, clockwise from north")
+    thickness_m: Positive | None = Field(None, description="not needed for the top layer")
+
+
+class WindConfig(_Strict):
+    layers: list[WindLayerConfig] = Field([WindLayerConfig(speed_mps=0.0, from_deg=0.0)], min_length=1)
+
+    @model_validator(mode="after")
+    def _thicknesses(self):
+        for i, layer in enumerate(self.layers[:-1]):
+            if layer.thickness_m is None:
+                raise ValueError(f"layers.{i}.thickness_m is required below the top layer")
+        return self
+
+
+class EnvironmentConfig(_Strict):
+    wind: WindConfig = WindConfig()
+
+
+class Dispersion(_Strict):
+    """How one parameter is drawn: normal (mean defaults to the nominal value; optional low/high
+    clip the draw), uniform [low, high], or a choice among values (optional weights)."""
+
+    dist: Literal["normal", "uniform", "choice"]
+    mean: float | None = None
+    std: NonNegative | None = None
+    low: float | None = None
+    high: float | None = None
+    values: list[float] | None = Field(None, min_length=1)
+    weights: list[NonNegative] | None = None
+
+    @model_validator(mode="after")
+    def _parameters(self):
+        need = {"normal": ("std",), "uniform": ("low", "high"), "choice": ("values",)}[self.dist]
+        allowed = {"normal": {"mean", "std", "low", "high"}, "uniform": {"low", "high"},
+                   "choice": {"values", "weights"}}[self.dist]  # fmt: skip
+        for name in need:
+            if getattr(self, name) is None:
+                raise ValueError(f"a {self.dist} dispersion needs '{name}'")
+        for name in {"mean", "std", "low", "high", "values", "weights"} - allowed:
+            if getattr(self, name) is not None:
+                raise ValueError(f"'{name}' does not apply to a {self.dist} dispersion")
+        if self.low is not None and self.high is not None and not self.low < self.high:
+            raise ValueError(f"low must be below high, got {self.low} and {self.high}")
+        if self.weights is not None and (len(self.weights) != len(self.values) or sum(self.weights) <= 0):
+            raise ValueError("weights must match values in length and have a positive sum")
+        return self
+
+
+class SimulationConfig(_Strict):
+    control_dt_s: float = Field(0.02, gt=0, le=0.1, description="GNC period")
+    substeps: int = Field(1, ge=1, le=100, description="RK4 steps per control period")
+    max_time_s: Positive = 300.0
+    chunk_size: int = Field(1000, ge=1, description="realizations per compiled batch")
+
+
+class CampaignConfig(_Strict):
+    name: str
+    description: str = ""
+    n_realizations: int = Field(ge=1)
+    seed: int = Field(ge=0, lt=2**32)
+    rocket: RocketConfig
+    site: SiteConfig
+    launch: LaunchConfig
+    environment: EnvironmentConfig = EnvironmentConfig()
+    dispersions: dict[str, Dispersion] = {}
+    simulation: SimulationConfig = SimulationConfig()
+
+
+@dataclasses.dataclass(frozen=True)
+class Campaign:
+    """A validated campaign: the config, its TOML text, the thrust curve and the nominal values of
+    every dispersible number, keyed by dotted path (``"rocket.dry_mass_kg"``, ``"rocket.aero.ca0.2"``)."""
+
+    config: CampaignConfig
+    text: str
+    thrust_time_s: np.ndarray
+    thrust_n: np.ndarray
+    nominal: dict[str, float]
+
+    def with_overrides(self, n_realizations: int | None = None, seed: int | None = None) -> Campaign:
+        """The same campaign with N and/or the seed replaced (CLI options)."""
+        update = {k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None}
+        data = self.config.model_dump()
+        data.update(update)
+        return dataclasses.replace(self, config=_validate(data))
+
+
+def _format_error(error: ValidationError) -> str:
+    first = error.errors()[0]
+    path = ".".join(str(p) for p in first["loc"]) or "(top level)"
+    if first["type"] == "extra_forbidden":
+        return f"{path}: unknown key"
+    if first["type"] == "missing":
+        return f"{path}: missing (required)"
+    message = first["msg"].removeprefix("Value error, ")
+    found = first.get("input")
+    shown = "" if isinstance(found, dict | list) else f" (got {found!r})"
+    return f"{path}: {message}{shown}"
+
+
+def _validate(data: dict) -> CampaignConfig:
+    try:
+        return CampaignConfig.model_validate(data)
+    except ValidationError as e:
+        raise ConfigError(_format_error(e)) from None
+
+
+def _deep_merge(base: dict, override: dict) -> dict:
+    merged = copy.deepcopy(base)
+    for key, value in override.items():
+        if isinstance(value, dict) and isinstance(merged.get(key), dict):
+            merged[key] = _deep_merge(merged[key], value)
+        else:
+            merged[key] = value
+    return merged
+
+
+def preset_rocket(name: str) -> dict:
+    """The rocket table of a built-in preset (``data/rockets/<name>.toml``)."""
+    resource = resources.files("rocketmc") / "data" / "rockets" / f"{name}.toml"
+    if not resource.is_file():
+        available = sorted(p.name.removesuffix(".toml") for p in resource.parent.iterdir())
+        raise ConfigError(f"rocket.preset: unknown preset {name!r} (available: {', '.join(available)})")
+    return tomllib.loads(resource.read_text())
+
+
+def _resolve_thrust_curve(name: str, base_dir: Path) -> Path:
+    candidate = base_dir / name
+    if candidate.is_file():
+        return candidate
+    builtin = resources.files("rocketmc") / "data" / "motors" / name
+    if builtin.is_file():
+        return Path(str(builtin))
+    raise ConfigError(f"rocket.motor.thrust_curve: file not found: {name!r} (neither beside the campaign nor built in)")
+
+
+def flatten_numbers(tree, prefix: str = "") -> dict[str, float]:
+    """Numeric leaves (not bools) of nested dicts/lists, keyed by dotted path."""
+    items = tree.items() if isinstance(tree, dict) else enumerate(tree) if isinstance(tree, list) else None
+    if items is None:
+        return {prefix: float(tree)} if isinstance(tree, int | float) and not isinstance(tree, bool) else {}
+    out = {}
+    for key, value in items:
+        out.update(flatten_numbers(value, f"{prefix}.{key}" if prefix else str(key)))
+    return out
+
+
+def _set_path(data: dict, path: str, value: float) -> dict:
+    data = copy.deepcopy(data)
+    *parents, last = path.split(".")
+    node = data
+    for p in parents:
+        node = node[int(p)] if isinstance(node, list) else node[p]
+    if isinstance(node, list):
+        node[int(last)] = value
+    else:
+        node[last] = value
+    return data
+
+
+def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> None:
+    """Each dispersion names a dispersible number and every value it can draw passes validation."""
+    data = config.model_dump(exclude={"dispersions"})
+    for path, d in config.dispersions.items():
+        field = f"dispersions.{path}"
+        if path not in nominal:
+            raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
+                              f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
+        for value in [d.mean, d.low, d.high, *(d.values or [])]:
+            if value is None:
+                continue
+            try:
+                CampaignConfig.model_validate(_set_path(data, path, value))
+            except ValidationError as e:
+                raise ConfigError(f"{field}: draws a value {value!r} that is out of range: {_format_error(e)}") from None
+
+
+def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
+    """Validate a campaign from its TOML text; relative files are looked up from ``base_dir``."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(f"not valid TOML: {e}") from None
+    rocket = raw.get("rocket")
+    if isinstance(rocket, dict) and "preset" in rocket:
+        overrides = {k: v for k, v in rocket.items() if k != "preset"}
+        if not isinstance(rocket["preset"], str):
+            raise ConfigError(f"rocket.preset: expected a string (got {rocket['preset']!r})")
+        raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"]), overrides)
+    config = _validate(raw)
+
+    path = _resolve_thrust_curve(config.rocket.motor.thrust_curve, base_dir)
+    try:
+        time_s, thrust_n = read_thrust_curve(path)
+    except ThrustCurveError as e:
+        raise ConfigError(f"rocket.motor.thrust_curve: {e}") from None
+    motor = config.rocket.motor
+    if motor.isp_s is not None:
+        curve_isp = cumulative_impulse(time_s, thrust_n)[-1] / (G0 * motor.propellant_mass_kg)
+        if abs(curve_isp / motor.isp_s - 1.0) > ISP_TOLERANCE:
+            raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
+                              f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
+
+    dump = config.model_dump()
+    nominal = {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
+    _check_dispersions(config, nominal)
+    return Campaign(config, text, time_s, thrust_n, nominal)
+
+
+def load_campaign(path: str | Path) -> Campaign:
+    """Read and validate a campaign file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"campaign file not found: {path}")
+    return parse_campaign(path.read_text(), path.parent)

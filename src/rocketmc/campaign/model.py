@@ -1,0 +1,113 @@
+"""From the numbers of a campaign (nominal or drawn) to the ``FlightParams`` of one flight.
+
+Pure and jittable: ``values`` maps dotted paths to scalars (Python floats for the nominal ones,
+traced arrays for the dispersed ones), so every unit conversion below happens per realization.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import jax.numpy as jnp
+
+from ..aero import LinearAero
+from ..dynamics import Motor, Parachute
+from ..dynamics.propulsion import cumulative_impulse
+from ..env import WindLayers
+from ..sim.params import Environment, FlightParams, Launch, Rocket
+from .config import Campaign
+
+
+def _vector(values: Mapping, path: str, n: int):
+    return jnp.stack([jnp.asarray(values[f"{path}.{i}"], dtype=float) for i in range(n)])
+
+
+def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
+    """FlightParams from ``values`` (dotted path -> scalar) and the campaign's static structure."""
+    cfg = campaign.config
+    v = {k: jnp.asarray(x, dtype=float) for k, x in values.items()}
+    ref = v["rocket.reference_point_m"]
+
+    def body_x(path):  # distance from the nose tip (aft) -> body-frame x (forward) from the reference
+        return ref - v[path]
+
+    m = "rocket.motor"
+    grain_center = (
+        body_x(f"{m}.grain_center_m")
+        if cfg.rocket.motor.grain_center_m is not None
+        else body_x(f"{m}.nozzle_m") + 0.5 * v[f"{m}.grain_length_m"]
+    )
+    thrust_n = jnp.asarray(campaign.thrust_n) * v[f"{m}.thrust_scale"]
+    motor = Motor(
+        time_s=jnp.asarray(campaign.thrust_time_s),
+        thrust_n=thrust_n,
+        impulse_ns=jnp.asarray(cumulative_impulse(campaign.thrust_time_s, campaign.thrust_n)) * v[f"{m}.thrust_scale"],
+        ignition_time_s=v[f"{m}.ignition_delay_s"],
+        propellant_mass_kg=v[f"{m}.propellant_mass_kg"],
+        grain_outer_diameter_m=v[f"{m}.grain_outer_diameter_m"],
+        grain_inner_diameter_m=v[f"{m}.grain_inner_diameter_m"],
+        grain_length_m=v[f"{m}.grain_length_m"],
+        grain_center_x_m=grain_center,
+        nozzle_x_m=body_x(f"{m}.nozzle_m"),
+    )
+
+    a = "rocket.aero"
+    n_mach = len(cfg.rocket.aero.ca0_mach)
+    aero = LinearAero(
+        reference_area_m2=v[f"{a}.reference_area_m2"],
+        reference_length_m=v[f"{a}.reference_length_m"],
+        moment_ref_x_m=jnp.zeros_like(ref),
+        ca0_mach=_vector(v, f"{a}.ca0_mach", n_mach),
+        ca0=_vector(v, f"{a}.ca0", n_mach),
+        drag_scale=v[f"{a}.drag_scale"],
+        ca_u=_vector(v, f"{a}.ca_u", 4),
+        **{k: v[f"{a}.{k}"] for k in ("cn_alpha", "cn_delta", "cm_alpha", "cm_delta", "cl0", "cl_delta",
+                                       "cy_r", "cn_q", "cl_p", "cm_q")},
+    )  # fmt: skip
+
+    parachutes = []
+    for i, chute in enumerate(cfg.rocket.parachutes):
+        c = f"rocket.parachutes.{i}"
+        altitude = v[f"{c}.deploy_altitude_m"] if chute.deploy_altitude_m is not None else jnp.inf
+        parachutes.append(
+            Parachute(
+                cd_s_m2=v[f"{c}.cd"] * v[f"{c}.area_m2"],
+                trigger_altitude_agl_m=jnp.asarray(altitude, dtype=float),
+                delay_s=v[f"{c}.delay_s"],
+                opening_time_s=v[f"{c}.opening_time_s"],
+                attach_x_m=body_x(f"{c}.attach_m"),
+                name=chute.name,
+            )
+        )
+
+    rocket = Rocket(
+        dry_mass_kg=v["rocket.dry_mass_kg"],
+        dry_cg_x_m=body_x("rocket.dry_cg_m"),
+        dry_ixx_kgm2=v["rocket.dry_inertia_kgm2.0"],
+        dry_iyy_kgm2=v["rocket.dry_inertia_kgm2.1"],
+        rear_lug_x_m=body_x("rocket.rear_lug_m"),
+        motor=motor,
+        aero=aero,
+        parachutes=tuple(parachutes),
+        canopy_cl_p=v["rocket.canopy_roll_damping"],
+    )
+    launch = Launch.from_angles(
+        v["launch.rail_length_m"], jnp.deg2rad(v["launch.elevation_deg"]), jnp.deg2rad(v["launch.azimuth_deg"])
+    )
+    layers = cfg.environment.wind.layers
+    w = "environment.wind.layers"
+    bottoms = [jnp.zeros_like(ref)]
+    for i in range(len(layers) - 1):
+        bottoms.append(bottoms[-1] + v[f"{w}.{i}.thickness_m"])
+    wind = WindLayers.from_speed_direction(
+        jnp.stack(bottoms),
+        jnp.stack([v[f"{w}.{i}.speed_mps"] for i in range(len(layers))]),
+        jnp.deg2rad(jnp.stack([v[f"{w}.{i}.from_deg"] for i in range(len(layers))])),
+    )
+    environment = Environment(site_altitude_m=jnp.asarray(cfg.site.altitude_m, dtype=float), wind=wind)
+    return FlightParams(rocket, launch, environment)
+
+
+def nominal_params(campaign: Campaign) -> FlightParams:
+    """FlightParams of the nominal (undispersed) flight."""
+    return flight_params(campaign, campaign.nominal)

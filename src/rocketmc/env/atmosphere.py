@@ -1,0 +1,82 @@
+"""International Standard Atmosphere (ISO 2533 / U.S. Standard Atmosphere 1976), 0–47 km.
+
+Altitudes are geometric metres above mean sea level; the layer formulas use geopotential
+altitude H = R0·z/(R0 + z). Above 47 km the state is held at the 47 km value (the caller flags
+that as out of range).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax.numpy as jnp
+import numpy as np
+
+G0 = 9.80665  # standard gravity [m/s²]
+R_AIR = 287.05287  # specific gas constant of dry air [J/(kg·K)]
+GAMMA_AIR = 1.4  # ratio of specific heats [-]
+R_EARTH_GEOPOTENTIAL = 6356766.0  # radius used for geopotential altitude [m]
+T0 = 288.15  # sea-level temperature [K]
+P0 = 101325.0  # sea-level pressure [Pa]
+
+# Layer bases (geopotential m) and temperature lapse rates (K/m): troposphere, tropopause,
+# two stratosphere layers.
+_BASE_H = (0.0, 11000.0, 20000.0, 32000.0)
+_LAPSE = (-0.0065, 0.0, 0.001, 0.0028)
+MAX_ALTITUDE_M = 47000.0 * R_EARTH_GEOPOTENTIAL / (R_EARTH_GEOPOTENTIAL - 47000.0)
+MIN_ALTITUDE_M = -2000.0
+
+
+def _layer_bases():
+    """Base temperature [K] and pressure [Pa] of each layer, integrated once on the host."""
+    temps, pressures = [T0], [P0]
+    for i in range(1, len(_BASE_H)):
+        dh, lapse, tb, pb = _BASE_H[i] - _BASE_H[i - 1], _LAPSE[i - 1], temps[-1], pressures[-1]
+        if lapse == 0.0:
+            pressures.append(pb * np.exp(-G0 * dh / (R_AIR * tb)))
+            temps.append(tb)
+        else:
+            t_top = tb + lapse * dh
+            pressures.append(pb * (t_top / tb) ** (-G0 / (R_AIR * lapse)))
+            temps.append(t_top)
+    return tuple(temps), tuple(pressures)
+
+
+_BASE_T, _BASE_P = _layer_bases()
+
+
+class AtmosphereState(NamedTuple):
+    """Air at one altitude: temperature [K], pressure [Pa], density [kg/m³], speed of sound [m/s]."""
+
+    temperature: jnp.ndarray
+    pressure: jnp.ndarray
+    density: jnp.ndarray
+    speed_of_sound: jnp.ndarray
+
+
+def geopotential_altitude(z):
+    """Geopotential altitude [m] of the geometric altitude ``z`` [m]."""
+    return R_EARTH_GEOPOTENTIAL * z / (R_EARTH_GEOPOTENTIAL + z)
+
+
+def isa(altitude_msl) -> AtmosphereState:
+    """ISA state at a geometric altitude above mean sea level [m], clamped to [-2, 47] km."""
+    z = jnp.clip(altitude_msl, MIN_ALTITUDE_M, MAX_ALTITUDE_M)
+    h = geopotential_altitude(z)
+    hb, tb, pb, lapse = _BASE_H[0], _BASE_T[0], _BASE_P[0], _LAPSE[0]
+    for i in range(1, len(_BASE_H)):
+        above = h >= _BASE_H[i]
+        hb = jnp.where(above, _BASE_H[i], hb)
+        tb = jnp.where(above, _BASE_T[i], tb)
+        pb = jnp.where(above, _BASE_P[i], pb)
+        lapse = jnp.where(above, _LAPSE[i], lapse)
+    isothermal = lapse == 0.0
+    temperature = tb + lapse * (h - hb)
+    safe_lapse = jnp.where(isothermal, 1.0, lapse)
+    pressure = jnp.where(
+        isothermal,
+        pb * jnp.exp(-G0 * (h - hb) / (R_AIR * tb)),
+        pb * (temperature / tb) ** (-G0 / (R_AIR * safe_lapse)),
+    )
+    density = pressure / (R_AIR * temperature)
+    return AtmosphereState(temperature, pressure, density, jnp.sqrt(GAMMA_AIR * R_AIR * temperature))

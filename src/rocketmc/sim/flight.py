@@ -1,0 +1,367 @@
+"""One flight, from the rail to the ground: the right-hand side, the control-period step, events.
+
+Single-vehicle and pure; ``campaign.runner`` is the only place that applies ``jit``/``vmap``.
+Phases are masks, not branches: on the rail, under canopy and on the ground all run the same
+code. Event times are ``inf`` until the event happens.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import functools
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from ..aero import air_data, linear_aero_wrench
+from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
+from ..dynamics.propulsion import grain_inertia
+from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
+from ..env import G0, isa, layered_wind
+from ..math import Quat, Vec3, rk4_step
+from ..pytree import pytree_dataclass, tree_where
+from .params import FlightParams, SimSettings
+
+
+class Status(enum.IntEnum):
+    """Outcome of one realization; the value is stored in ``/outputs/status``."""
+
+    OK = 0
+    NON_FINITE = 1
+    MAX_TIME = 2
+
+    @property
+    def message(self) -> str:
+        return {
+            Status.OK: "ok",
+            Status.NON_FINITE: "the state became NaN or infinite; the flight was stopped there",
+            Status.MAX_TIME: "not on the ground at the maximum simulated time (raise max_time_s?)",
+        }[self]
+
+
+@pytree_dataclass
+class Events:
+    """Event times [s] (``inf`` until they happen) and the values interpolated at them (SI, NED)."""
+
+    rail_exit_time: jnp.ndarray
+    rail_exit_speed: jnp.ndarray
+    burnout_time: jnp.ndarray
+    burnout_altitude: jnp.ndarray
+    burnout_speed: jnp.ndarray
+    apogee_time: jnp.ndarray
+    apogee_altitude: jnp.ndarray
+    apogee_north: jnp.ndarray
+    apogee_east: jnp.ndarray
+    chute_trigger_times: tuple
+    impact_time: jnp.ndarray
+    impact_north: jnp.ndarray
+    impact_east: jnp.ndarray
+    impact_speed: jnp.ndarray
+    max_mach: jnp.ndarray
+    max_qbar: jnp.ndarray
+    non_finite: jnp.ndarray
+
+
+@pytree_dataclass
+class FlightState:
+    """Time [s], rigid-body state, the event record, and the squared pendulum rate of the body
+    swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the descent step."""
+
+    t: jnp.ndarray
+    body: RigidBodyState
+    events: Events
+    canopy_stiffness: jnp.ndarray
+
+
+class Diagnostics(NamedTuple):
+    """By-products of the right-hand side: Mach [-], dynamic pressure [Pa], canopy ω² [1/s²]."""
+
+    mach: jnp.ndarray
+    qbar: jnp.ndarray
+    canopy_stiffness: jnp.ndarray
+
+
+def mass_properties(p: FlightParams, t) -> MassProperties:
+    """Mass, CG and inertia of the rocket with the propellant left at time ``t``."""
+    r, motor = p.rocket, p.rocket.motor
+    m_prop = propellant_mass(motor, t)
+    grain_ixx, grain_iyy = grain_inertia(motor, m_prop)
+    return combine_on_axis(
+        [
+            (r.dry_mass_kg, r.dry_cg_x_m, r.dry_ixx_kgm2, r.dry_iyy_kgm2),
+            (m_prop, motor.grain_center_x_m, grain_ixx, grain_iyy),
+        ]
+    )
+
+
+def derivatives(t, body: RigidBodyState, p: FlightParams, u, events: Events):
+    """State derivative and ``Diagnostics`` at ``t`` under canard commands ``u`` (yaw, pitch, roll, squeeze)."""
+    rocket, env = p.rocket, p.environment
+    mass = mass_properties(p, t)
+    altitude = -body.r_n.z
+    altitude_msl = env.site_altitude_m + altitude
+    atmosphere = isa(altitude_msl)
+    wind_n = layered_wind(env.wind, altitude)
+    q_nb, omega_b = body.q_nb, body.omega_b
+    air = air_data(q_nb.rotate_inverse(body.v_n - wind_n), atmosphere, altitude_msl)
+
+    force_n = Vec3.zeros(t)
+    moment_b = Vec3.zeros(t)
+    under_canopy = jnp.zeros_like(t, dtype=bool)
+    stiffness = jnp.zeros_like(t)
+    for chute, trigger_time in zip(rocket.parachutes, events.chute_trigger_times):
+        fraction = open_fraction(chute, trigger_time, t)
+        arm_b = Vec3(chute.attach_x_m - mass.cg_x, 0.0, 0.0)
+        v_air_n = body.v_n + q_nb.rotate(omega_b.cross(arm_b)) - wind_n
+        drag_n = parachute_drag_n(chute, fraction, v_air_n, atmosphere.density)
+        force_n = force_n + drag_n
+        moment_b = moment_b + arm_b.cross(q_nb.rotate_inverse(drag_n))
+        under_canopy = under_canopy | (fraction > 0.0)
+        stiffness = stiffness + drag_n.norm() * jnp.abs(arm_b.x) / mass.iyy
+
+    aero_force_b, aero_moment_b = linear_aero_wrench(
+        rocket.aero, air, omega_b, u, rocket.canopy_cl_p, under_canopy
+    )
+    aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
+    moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
+    force_b = aero_force_b + Vec3(thrust(rocket.motor, t), 0.0, 0.0)
+    free = rigid_body_derivatives(body, mass, force_b, force_n, moment_b, G0)
+
+    # On the rail: motion along it only, no rotation, no sliding back down before liftoff.
+    rail = p.launch.rail_direction_n
+    accel_along = free.v_n.dot(rail)
+    accel_along = jnp.where((body.v_n.dot(rail) > 0.0) | (accel_along > 0.0), accel_along, 0.0)
+    zero = jnp.zeros_like(accel_along)
+    on_rail = RigidBodyState(body.v_n, rail * accel_along, Quat(zero, zero, zero, zero), Vec3(zero, zero, zero))
+    d_body = tree_where(jnp.isinf(events.rail_exit_time), on_rail, free)
+    return d_body, Diagnostics(air.mach, air.qbar, stiffness)
+
+
+def _crossing_fraction(g0, g1):
+    """Fraction of a step at which g (linear in the step) reaches 0 from above; 0 if already there."""
+    dg = g0 - g1
+    return jnp.clip(jnp.where(g0 > 0.0, g0 / jnp.where(dg != 0.0, dg, 1.0), 0.0), 0.0, 1.0)
+
+
+def _lerp(a, b, s):
+    return a + s * (b - a)
+
+
+def _record(event_time, hit, t0, h, s):
+    return jnp.where(hit, t0 + s * h, event_time)
+
+
+def rail_start_n(p: FlightParams) -> Vec3:
+    """CG position at rest on the rail, the nozzle exit at the pad [m, NED]."""
+    return p.launch.rail_direction_n * (mass_properties(p, 0.0).cg_x - p.rocket.motor.nozzle_x_m)
+
+
+def update_events(
+    p: FlightParams, start_n: Vec3, ev: Events, t0, h, b0: RigidBodyState, b1: RigidBodyState, diag: Diagnostics
+) -> Events:
+    """Detect the events inside the step ``[t0, t0 + h]`` from ``b0`` to ``b1`` and interpolate them.
+
+    start_n: ``rail_start_n(p)``, passed in so that it is computed once per flight.
+    """
+    rail = p.launch.rail_direction_n
+    motor = p.rocket.motor
+    speed0, speed1 = b0.v_n.norm(), b1.v_n.norm()
+    alt0, alt1 = -b0.r_n.z, -b1.r_n.z
+
+    # Rail exit: the rear lug passes the top of the rail (the nozzle started at its foot); the CG
+    # shift while on the rail (< 1 cm for Lynx) is neglected.
+    travel_to_exit = p.launch.rail_length_m - (p.rocket.rear_lug_x_m - motor.nozzle_x_m)
+    g0 = travel_to_exit - (b0.r_n - start_n).dot(rail)
+    g1 = travel_to_exit - (b1.r_n - start_n).dot(rail)
+    hit = jnp.isinf(ev.rail_exit_time) & (g1 <= 0.0)
+    s = _crossing_fraction(g0, g1)
+    rail_exit_time = _record(ev.rail_exit_time, hit, t0, h, s)
+    rail_exit_speed = jnp.where(hit, _lerp(speed0, speed1, s), ev.rail_exit_speed)
+
+    # Burnout: the end of the thrust curve, a known time.
+    t_bo = motor.ignition_time_s + motor.burn_time_s
+    hit = jnp.isinf(ev.burnout_time) & (t0 + h >= t_bo)
+    s = jnp.clip((t_bo - t0) / h, 0.0, 1.0)
+    burnout_time = _record(ev.burnout_time, hit, t0, h, s)
+    burnout_altitude = jnp.where(hit, _lerp(alt0, alt1, s), ev.burnout_altitude)
+    burnout_speed = jnp.where(hit, _lerp(speed0, speed1, s), ev.burnout_speed)
+
+    # Apogee: the vertical velocity changes sign; altitude from the cubic Hermite interpolant.
+    climb0, climb1 = -b0.v_n.z, -b1.v_n.z
+    hit = jnp.isfinite(rail_exit_time) & jnp.isinf(ev.apogee_time) & (climb1 <= 0.0)
+    s = _crossing_fraction(climb0, climb1)
+    hermite_alt = (
+        (2 * s**3 - 3 * s**2 + 1) * alt0
+        + (s**3 - 2 * s**2 + s) * h * climb0
+        + (-2 * s**3 + 3 * s**2) * alt1
+        + (s**3 - s**2) * h * climb1
+    )
+    apogee_time = _record(ev.apogee_time, hit, t0, h, s)
+    apogee_altitude = jnp.where(hit, hermite_alt, ev.apogee_altitude)
+    apogee_north = jnp.where(hit, _lerp(b0.r_n.x, b1.r_n.x, s), ev.apogee_north)
+    apogee_east = jnp.where(hit, _lerp(b0.r_n.y, b1.r_n.y, s), ev.apogee_east)
+    past_apogee = jnp.isfinite(apogee_time)
+
+    # Parachute triggers: after apogee, at or below the trigger altitude (inf: at apogee).
+    triggers = []
+    for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
+        g0, g1 = alt0 - chute.trigger_altitude_agl_m, alt1 - chute.trigger_altitude_agl_m
+        hit = past_apogee & jnp.isinf(trigger_time) & (g1 <= 0.0)
+        crossing_time = t0 + _crossing_fraction(g0, g1) * h
+        triggers.append(jnp.where(hit, jnp.maximum(crossing_time, apogee_time), trigger_time))
+
+    # Impact: the CG reaches the ground after apogee.
+    hit = past_apogee & jnp.isinf(ev.impact_time) & (alt1 <= 0.0)
+    s = _crossing_fraction(alt0, alt1)
+    impact_time = _record(ev.impact_time, hit, t0, h, s)
+    impact_north = jnp.where(hit, _lerp(b0.r_n.x, b1.r_n.x, s), ev.impact_north)
+    impact_east = jnp.where(hit, _lerp(b0.r_n.y, b1.r_n.y, s), ev.impact_east)
+    impact_speed = jnp.where(hit, _lerp(speed0, speed1, s), ev.impact_speed)
+
+    return Events(
+        rail_exit_time, rail_exit_speed, burnout_time, burnout_altitude, burnout_speed,
+        apogee_time, apogee_altitude, apogee_north, apogee_east, tuple(triggers),
+        impact_time, impact_north, impact_east, impact_speed,
+        jnp.maximum(ev.max_mach, diag.mach), jnp.maximum(ev.max_qbar, diag.qbar), ev.non_finite,
+    )  # fmt: skip
+
+
+def initial_state(p: FlightParams) -> FlightState:
+    """At rest on the rail, the nozzle exit at the pad, t = 0."""
+    zero = jnp.zeros_like(p.rocket.dry_mass_kg)
+    inf = zero + jnp.inf
+    body = RigidBodyState(rail_start_n(p), Vec3(zero, zero, zero), p.launch.q_nb0, Vec3(zero, zero, zero))
+    events = Events(
+        inf, zero, inf, zero, zero, inf, zero, zero, zero,
+        tuple(inf for _ in p.rocket.parachutes), inf, zero, zero, zero, zero, zero,
+        jnp.zeros_like(zero, dtype=bool),
+    )  # fmt: skip
+    return FlightState(zero, body, events, zero)
+
+
+def done(state: FlightState):
+    """True once the flight has landed or stopped on a non-finite state."""
+    return jnp.isfinite(state.events.impact_time) | state.events.non_finite
+
+
+def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
+    """True under a fully open canopy once every triggered opening has settled, unless a wind-layer
+    boundary is within one descent step (its wind jump is a transient too)."""
+    t, events = state.t, state.events
+    any_open, transient = False, False
+    for chute, trigger_time in zip(p.rocket.parachutes, events.chute_trigger_times):
+        settled = trigger_time + chute.delay_s + chute.opening_time_s + settings.settle_s
+        any_open = any_open | (t >= settled)
+        transient = transient | (jnp.isfinite(trigger_time) & (t < settled))
+    altitude = -state.body.r_n.z
+    reach = jnp.abs(state.body.v_n.z) * settings.descent_dt_s + 1.0
+    bottoms = p.environment.wind.bottom_m
+    for k in range(1, bottoms.shape[0]):
+        transient = transient | (jnp.abs(altitude - bottoms[k]) < reach)
+    return any_open & ~transient
+
+
+def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState) -> FlightState:
+    """One control period: (GNC plugs in here) then RK4 substeps of the rigid body with events.
+
+    The period is ``settings.control_dt_s``; in steady descent under canopy it grows up to
+    ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ 0.5.
+    Each realization keeps its own clock.
+    """
+    u = (0.0, 0.0, 0.0, 0.0)  # canard commands (yaw, pitch, roll, squeeze) [rad]; GNC comes later
+    stable_period = settings.substeps * 0.5 / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
+    descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
+    period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
+    h = period / settings.substeps
+
+    def substep(carry, _):
+        t0, body0, events, _ = carry
+        rhs = lambda t, y: derivatives(t, y, p, u, events)  # noqa: E731
+        body1, diag = rk4_step(rhs, t0, body0, h)
+        body1 = normalize_attitude(body1)
+        events = update_events(p, start_n, events, t0, h, body0, body1, diag)
+        return (t0 + h, body1, events, diag.canopy_stiffness), None
+
+    carry = (state.t, state.body, state.events, state.canopy_stiffness)
+    (t, body, events, stiffness), _ = jax.lax.scan(substep, carry, None, settings.substeps)
+    finite = functools.reduce(jnp.logical_and, [jnp.isfinite(x) for x in jax.tree_util.tree_leaves(body)])
+    body = tree_where(done(state) | ~finite, state.body, body)
+    events = tree_where(done(state), state.events, events)
+    events = dataclasses.replace(events, non_finite=events.non_finite | ~finite)
+    return FlightState(state.t + period, body, events, stiffness)
+
+
+def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
+    """Fly until landed, stopped or ``settings.max_time_s``; return (summary dict, status code).
+
+    The loop runs in blocks of ``settings.block_steps`` control periods; under ``vmap`` the batch
+    stops as soon as every member is done.
+    """
+
+    start_n = rail_start_n(p)
+
+    def block(state):
+        def step(s, _):
+            return control_step(p, settings, start_n, s), None
+
+        return jax.lax.scan(step, state, None, settings.block_steps)[0]
+
+    def keep_going(state):
+        return ~done(state) & (state.t < settings.max_time_s)
+
+    final = jax.lax.while_loop(keep_going, block, initial_state(p))
+    return flight_summary(p, final)
+
+
+def fly(p: FlightParams, settings: SimSettings, duration_s: float):
+    """Fly for a fixed duration and return (final state, trajectory): the trajectory is the
+    ``FlightState`` after each control period, stacked along a leading time axis."""
+
+    start_n = rail_start_n(p)
+
+    def step(s, _):
+        s = control_step(p, settings, start_n, s)
+        return s, s
+
+    return jax.lax.scan(step, initial_state(p), None, int(round(duration_s / settings.control_dt_s)))
+
+
+def unit_of(name: str) -> str:
+    """Unit of a summary metric from its name's suffix."""
+    for suffix, unit in (("_mps", "m/s"), ("_pa", "Pa"), ("_m", "m"), ("_s", "s")):
+        if name.endswith(suffix):
+            return unit
+    return "1"
+
+
+def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarray]:
+    """Summary metrics (NaN for events that did not happen) and the status code."""
+    ev = state.events
+    landed = jnp.isfinite(ev.impact_time)
+
+    def when(time, value):
+        return jnp.where(jnp.isfinite(time), value, jnp.nan)
+
+    summary = {
+        "apogee_agl_m": when(ev.apogee_time, ev.apogee_altitude),
+        "apogee_time_s": when(ev.apogee_time, ev.apogee_time),
+        "apogee_north_m": when(ev.apogee_time, ev.apogee_north),
+        "apogee_east_m": when(ev.apogee_time, ev.apogee_east),
+        "max_mach": ev.max_mach,
+        "max_dynamic_pressure_pa": ev.max_qbar,
+        "rail_exit_time_s": when(ev.rail_exit_time, ev.rail_exit_time),
+        "rail_exit_speed_mps": when(ev.rail_exit_time, ev.rail_exit_speed),
+        "burnout_time_s": when(ev.burnout_time, ev.burnout_time),
+        "burnout_altitude_agl_m": when(ev.burnout_time, ev.burnout_altitude),
+        "burnout_speed_mps": when(ev.burnout_time, ev.burnout_speed),
+        "impact_north_m": when(ev.impact_time, ev.impact_north),
+        "impact_east_m": when(ev.impact_time, ev.impact_east),
+        "impact_time_s": when(ev.impact_time, ev.impact_time),
+        "impact_speed_mps": when(ev.impact_time, ev.impact_speed),
+    }
+    for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
+        summary[f"{chute.name}_deploy_time_s"] = when(trigger_time, trigger_time + chute.delay_s)
+    status = jnp.where(ev.non_finite, Status.NON_FINITE, jnp.where(landed, Status.OK, Status.MAX_TIME))
+    return summary, status.astype(jnp.int32)

@@ -1,0 +1,86 @@
+"""The parameter aggregate of one flight and the static simulation settings."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import jax.numpy as jnp
+
+from ..aero import LinearAero
+from ..dynamics import Motor, Parachute
+from ..env import WindLayers
+from ..math import Quat, Vec3
+from ..pytree import pytree_dataclass
+
+
+@pytree_dataclass
+class Rocket:
+    """Airframe without propellant, motor, aerodynamics and recovery.
+
+    dry_mass_kg: mass without propellant [kg]; dry_cg_x_m: its CG on the body x axis from the
+    reference point [m]; dry_ixx_kgm2, dry_iyy_kgm2: its inertia about that CG [kg·m²];
+    rear_lug_x_m: body-frame x of the rear launch lug [m]; canopy_cl_p: roll damping under canopy.
+    """
+
+    dry_mass_kg: jnp.ndarray
+    dry_cg_x_m: jnp.ndarray
+    dry_ixx_kgm2: jnp.ndarray
+    dry_iyy_kgm2: jnp.ndarray
+    rear_lug_x_m: jnp.ndarray
+    motor: Motor
+    aero: LinearAero
+    parachutes: tuple[Parachute, ...]
+    canopy_cl_p: jnp.ndarray
+
+
+@pytree_dataclass
+class Launch:
+    """rail_length_m [m]; rail_direction_n: unit vector up the rail in NED; q_nb0: attitude on the
+    rail (body x along the rail, no roll)."""
+
+    rail_length_m: jnp.ndarray
+    rail_direction_n: Vec3
+    q_nb0: Quat
+
+    @classmethod
+    def from_angles(cls, rail_length_m, elevation_rad, azimuth_rad) -> Launch:
+        """Rail of given length, elevation above the horizon and azimuth clockwise from north."""
+        ce = jnp.cos(elevation_rad)
+        direction = Vec3(ce * jnp.cos(azimuth_rad), ce * jnp.sin(azimuth_rad), -jnp.sin(elevation_rad))
+        return cls(jnp.asarray(rail_length_m), direction, Quat.from_euler(azimuth_rad, elevation_rad, 0.0))
+
+
+@pytree_dataclass
+class Environment:
+    """site_altitude_m: pad altitude above mean sea level [m]; wind: layered wind."""
+
+    site_altitude_m: jnp.ndarray
+    wind: WindLayers
+
+
+@pytree_dataclass
+class FlightParams:
+    """Everything one realization needs (all leaves dynamic: they can be dispersed)."""
+
+    rocket: Rocket
+    launch: Launch
+    environment: Environment
+
+
+@dataclasses.dataclass(frozen=True)
+class SimSettings:
+    """Static settings (hashable; changing one recompiles).
+
+    control_dt_s: control period, the GNC rate [s]; substeps: RK4 steps per control period;
+    descent_dt_s: the longer period used under a fully open canopy, once opening transients have
+    settled (``settle_s`` after full opening); the GNC is idle then [s];
+    max_time_s: a flight not on the ground by then gets the status MAX_TIME;
+    block_steps: control periods per chunk of work between checks that the whole batch has landed.
+    """
+
+    control_dt_s: float = 0.02
+    substeps: int = 1
+    descent_dt_s: float = 0.1
+    settle_s: float = 1.0
+    max_time_s: float = 300.0
+    block_steps: int = 250
