@@ -48,6 +48,9 @@ def _run(args) -> int:
 def _report(args) -> int:
     from .analysis import format_summary, load_run, plot_impacts, summarize
 
+    if not Path(args.file).is_file():
+        print(f"rocketmc: error: {args.file}: file not found", file=sys.stderr)
+        return 2
     try:
         run = load_run(args.file)
     except (OSError, ValueError) as e:

@@ -1,0 +1,72 @@
+"""The command line: a small campaign end to end, and bad input (exit code 2, no result file)."""
+
+import json
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from rocketmc.cli import main
+
+CAMPAIGNS = Path(__file__).parents[1] / "campaigns"
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run") / "ballistic.h5"
+    assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), "-n", "6", "--seed", "7", "--out", str(out)]) == 0
+    return out
+
+
+def test_run_writes_the_contract(small_run):
+    with h5py.File(small_run) as f:
+        assert f.attrs["complete"] and f.attrs["n_realizations"] == 6 and f.attrs["seed"] == 7
+        assert "lynx_ballistic" in f.attrs["campaign_toml"]
+        for name in ("apogee_agl_m", "apogee_time_s", "max_mach", "max_dynamic_pressure_pa", "rail_exit_speed_mps",
+                     "impact_north_m", "impact_east_m", "impact_time_s", "impact_speed_mps", "status"):  # fmt: skip
+            assert f["outputs"][name].shape == (6,) and "unit" in f["outputs"][name].attrs
+        assert np.all(f["outputs/status"][:] == 0)
+        assert json.loads(f["outputs/status"].attrs["codes"])["0"] == "ok"
+        speeds = f["inputs/environment.wind.layers.1.speed_mps"][:]
+        assert np.all((speeds >= 0) & (speeds <= 30)) and len(set(speeds)) == 6
+    assert not Path(str(small_run) + ".partial").exists()
+
+
+def test_report_json_and_plot(small_run, tmp_path, capsys):
+    png = tmp_path / "impacts.png"
+    assert main(["report", str(small_run), "--json", "--plot", str(png)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n_ok"] == 6
+    level95 = [e for e in summary["impact_ellipses"] if e["level"] == 0.95][0]
+    assert level95["area_m2"] > 0
+    assert png.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ("elevation_deg = 84.0", "elevation_deg = 91.0", "launch.elevation_deg"),
+        ('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = -3.0', "rocket.dry_mass_kg"),
+        ("n_realizations = 1000\n", "", "n_realizations"),
+        ("seed = 2021", "seed = 2021\ncolour = 'red'", "colour"),
+    ],
+)
+def test_bad_campaign_exit_2_and_no_file(tmp_path, capsys, old, new, field):
+    campaign = tmp_path / "bad.toml"
+    campaign.write_text((CAMPAIGNS / "lynx_nominal.toml").read_text().replace(old, new, 1))
+    out = tmp_path / "out.h5"
+    assert main(["run", str(campaign), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and field in err, err
+    assert not list(tmp_path.glob("out.h5*"))
+
+
+def test_bad_arguments_exit_2(tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["run", str(CAMPAIGNS / "lynx_nominal.toml"), "-n", "0"])
+    assert info.value.code == 2
+    assert main(["run", str(tmp_path / "missing.toml")]) == 2
+    assert main(["report", str(tmp_path / "missing.h5")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 3 and "--n" in lines[0] and all("not found" in line for line in lines[1:]), lines
