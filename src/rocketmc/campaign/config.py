@@ -185,6 +185,7 @@ class Dispersion(_Strict):
 class SimulationConfig(_Strict):
     control_dt_s: float = Field(0.02, gt=0, le=0.1, description="GNC period")
     substeps: int = Field(1, ge=1, le=100, description="RK4 steps per control period")
+    descent_dt_s: float = Field(0.1, gt=0, le=1.0, description="longest period in steady descent under canopy")
     max_time_s: Positive = 300.0
     chunk_size: int = Field(1000, ge=1, description="realizations per compiled batch")
 

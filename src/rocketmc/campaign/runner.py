@@ -25,7 +25,10 @@ from .sampling import realization_key, sample_dispersions
 
 def sim_settings(campaign: Campaign) -> SimSettings:
     s = campaign.config.simulation
-    return SimSettings(control_dt_s=s.control_dt_s, substeps=s.substeps, max_time_s=s.max_time_s)
+    return SimSettings(
+        control_dt_s=s.control_dt_s, substeps=s.substeps, descent_dt_s=max(s.descent_dt_s, s.control_dt_s),
+        max_time_s=s.max_time_s,
+    )
 
 
 def realization(campaign: Campaign, settings: SimSettings, master_key, index):

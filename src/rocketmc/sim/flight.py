@@ -20,6 +20,7 @@ from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propella
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
 from ..env import G0, isa, layered_wind
+from ..gnc import mix
 from ..math import Quat, Vec3, rk4_step
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
@@ -270,7 +271,8 @@ def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: F
     ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ 0.5.
     Each realization keeps its own clock.
     """
-    u = (0.0, 0.0, 0.0, 0.0)  # canard commands (yaw, pitch, roll, squeeze) [rad]; GNC comes later
+    canards = (0.0, 0.0, 0.0, 0.0)  # fin deflections δ1..δ4 [rad]: held at zero until the controller lands
+    u = mix(*canards)
     stable_period = settings.substeps * 0.5 / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
     descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
     period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
