@@ -66,6 +66,9 @@ def _report(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"rocketmc {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = commands.add_parser("run", help="fly a campaign and write its HDF5 result file")
     run.add_argument("campaign", help="campaign file (TOML)")

@@ -40,7 +40,7 @@ def nominal_flight():
     """Calm-air nominal Lynx: (summary, status, trajectory) over 9000 control periods (past landing)."""
     params = calm(nominal_params(CAMPAIGN))
     summary, status = jax.jit(lambda p: simulate_one(p, SETTINGS))(params)
-    _, traj = jax.jit(lambda p: fly(p, SETTINGS, 9000 * SETTINGS.control_dt_s))(params)
+    _, traj = jax.jit(lambda p: fly(p, SETTINGS, 9000))(params)
     return params, summary, status, traj
 
 
@@ -48,7 +48,7 @@ def test_vacuum_ballistic_matches_the_parabola():
     params = calm(vacuum(nominal_params(CAMPAIGN)))
     settings = SimSettings()
     summary, status = jax.jit(lambda p: simulate_one(p, settings))(params)
-    _, traj = jax.jit(lambda p: fly(p, settings, 400 * settings.control_dt_s))(params)
+    _, traj = jax.jit(lambda p: fly(p, settings, 400))(params)
     k = 300  # t = 6 s: after burnout (3.784 s), before apogee; no torque, so no rotation
     t, r, v = float(traj.t[k]), traj.body.r_n, traj.body.v_n
     h, climb = -float(r.z[k]), -float(v.z[k])

@@ -317,17 +317,17 @@ def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndar
     return flight_summary(p, final)
 
 
-def fly(p: FlightParams, settings: SimSettings, duration_s: float):
-    """Fly for a fixed duration and return (final state, trajectory): the trajectory is the
-    ``FlightState`` after each control period, stacked along a leading time axis."""
-
+def fly(p: FlightParams, settings: SimSettings, n_periods: int):
+    """Fly ``n_periods`` control periods and return (final state, trajectory): the trajectory is the
+    ``FlightState`` after each period, stacked along a leading axis (``trajectory.t`` holds the
+    times, since periods grow in steady descent)."""
     start_n = rail_start_n(p)
 
     def step(s, _):
         s = control_step(p, settings, start_n, s)
         return s, s
 
-    return jax.lax.scan(step, initial_state(p), None, int(round(duration_s / settings.control_dt_s)))
+    return jax.lax.scan(step, initial_state(p), None, n_periods)
 
 
 def unit_of(name: str) -> str:

@@ -1,0 +1,46 @@
+"""Shared fixtures of the physics tests.
+
+Importing rocketmc first enables float64 in JAX for every test module (the tolerances below
+assume double precision). Compiled flights are expensive (~15 s each on CPU), so the test modules
+share them through module- or session-scoped fixtures and reuse one compilation for every
+parameter set of the same pytree structure.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import jax
+import pytest
+
+import rocketmc  # noqa: F401  (enables jax_enable_x64)
+
+REPO = Path(__file__).resolve().parents[1]
+CAMPAIGNS = REPO / "campaigns"
+MOTORS = REPO / "src" / "rocketmc" / "data" / "motors"
+
+
+def pytest_configure(config):
+    assert jax.config.jax_enable_x64, "rocketmc must enable float64 before the tests run"
+
+
+@pytest.fixture(scope="session")
+def lynx_campaign():
+    """The Lynx campaign (drogue + main, three-layer wind, dispersions)."""
+    from rocketmc.campaign.config import load_campaign
+
+    return load_campaign(CAMPAIGNS / "lynx_nominal.toml")
+
+
+@pytest.fixture(scope="session")
+def lynx_params(lynx_campaign):
+    """Nominal (undispersed) FlightParams of the Lynx campaign."""
+    from rocketmc.campaign.model import nominal_params
+
+    return nominal_params(lynx_campaign)
+
+
+@pytest.fixture(scope="session")
+def l1350_path():
+    """The vendored Cesaroni 4263L1350-P RASP curve."""
+    return MOTORS / "Cesaroni_4263L1350-P.eng"
