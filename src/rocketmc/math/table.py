@@ -1,0 +1,85 @@
+"""N-D multilinear interpolation of vector-valued tables, written for cheap evaluation under ``vmap``.
+
+A ``Table`` holds D strictly increasing (not necessarily uniform) axes and values of shape
+``(*grid, n_outputs)``; ``interpolate`` returns all outputs at one point from the 2^D corner rows
+of the point's cell, each one row gather at a constant offset from the cell's flat index.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import jax.numpy as jnp
+import numpy as np
+
+from rocketmc.pytree import pytree_dataclass, static_field
+
+
+@pytree_dataclass
+class Table:
+    """Gridded vector-valued function: ``values[i_0, ..., i_{D-1}, k]`` at ``(axes[0][i_0], ...)``.
+
+    Units are those of each axis and output; the names (static) document them.
+    """
+
+    axes: tuple[jnp.ndarray, ...]  # D arrays (n_d,), each strictly increasing, n_d >= 2
+    values: jnp.ndarray  # (n_0, ..., n_{D-1}, n_outputs)
+    axis_names: tuple[str, ...] = static_field()
+    output_names: tuple[str, ...] = static_field()
+
+    @classmethod
+    def from_numpy(cls, axes, values, axis_names, output_names) -> Table:
+        """Validated ``Table`` from host arrays; ``ValueError`` naming the offending axis or size."""
+        axis_names = tuple(axis_names)
+        output_names = tuple(output_names)
+        axes = [np.asarray(a, dtype=np.float64) for a in axes]
+        values = np.asarray(values, dtype=np.float64)
+        if len(axis_names) != len(axes):
+            raise ValueError(f"{len(axes)} axes but {len(axis_names)} axis names {axis_names}")
+        for name, a in zip(axis_names, axes):
+            if a.ndim != 1 or a.size < 2:
+                raise ValueError(f"axis {name!r} must be 1-D with at least 2 points, got shape {a.shape}")
+            if not np.all(np.isfinite(a)) or not np.all(np.diff(a) > 0):
+                raise ValueError(f"axis {name!r} must be finite and strictly increasing")
+        grid = tuple(a.size for a in axes)
+        if values.shape[:-1] != grid or values.ndim != len(axes) + 1:
+            raise ValueError(f"values shape {values.shape} must be grid {grid} + (n_outputs,) for axes {axis_names}")
+        if values.shape[-1] != len(output_names):
+            raise ValueError(f"{values.shape[-1]} outputs but {len(output_names)} output names")
+        return cls(tuple(jnp.asarray(a) for a in axes), jnp.asarray(values), axis_names, output_names)
+
+
+def interpolate(table: Table, point):
+    """Multilinear ``values`` (n_outputs,) at ``point`` (one scalar per axis) and an out-of-range flag.
+
+    Each coordinate is clamped to its axis range (constant extrapolation, zero gradient outside);
+    ``out_of_range`` is True if any coordinate was outside. Differentiable w.r.t. ``point``.
+
+    The cell is located once as a flat row index into ``values`` reshaped to (cells, n_outputs);
+    each of the 2^D corners is then one row gather at a constant offset, accumulated with its
+    weight. Under ``vmap`` XLA fuses these gathers into the weighted sum; a single (2^D, n_outputs)
+    gather instead materializes (N, 2^D, n_outputs) and ran ~10x slower on CPU (jax 0.10).
+    """
+    axes = table.axes
+    grid = table.values.shape[:-1]
+    strides = np.cumprod((1,) + grid[:0:-1])[::-1]  # row-major row strides of the grid
+
+    base = 0
+    fractions = []
+    out_of_range = jnp.asarray(False)
+    for a, x, stride in zip(axes, point, strides):
+        x = jnp.asarray(x, dtype=a.dtype)
+        out_of_range = out_of_range | (x < a[0]) | (x > a[-1])
+        xc = jnp.clip(x, a[0], a[-1])
+        i = jnp.clip(jnp.searchsorted(a, xc, side="right", method="compare_all") - 1, 0, a.shape[0] - 2)
+        fractions.append((xc - a[i]) / (a[i + 1] - a[i]))  # position inside the cell, in [0, 1]
+        base = base + i * int(stride)
+
+    rows = table.values.reshape(-1, table.values.shape[-1])
+    value = jnp.zeros(rows.shape[-1], rows.dtype)
+    for corner in itertools.product((0, 1), repeat=len(axes)):
+        weight = math.prod(t if bit else 1.0 - t for bit, t in zip(corner, fractions))
+        offset = int(np.dot(corner, strides))
+        value = value + weight * rows.at[base + offset].get(mode="promise_in_bounds")
+    return value, out_of_range
