@@ -13,7 +13,7 @@ import math
 import jax.numpy as jnp
 import numpy as np
 
-from rocketmc.pytree import pytree_dataclass, static_field
+from ..pytree import pytree_dataclass, static_field
 
 
 @pytree_dataclass
