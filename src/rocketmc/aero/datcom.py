@@ -12,7 +12,7 @@ from importlib import resources
 import numpy as np
 import scipy.io
 
-from rocketmc.math.table import Table
+from ..math.table import Table
 
 LYNX_DATCOM = resources.files("rocketmc") / "data" / "aero" / "lynx_datcom_full_2021-03-20.mat"
 
