@@ -134,7 +134,7 @@ def test_clamped_outside_range_and_finite():
             assert float(got) == float(ref)
     # within the range the state does vary (the clamp is not applied everywhere)
     assert float(isa_jit(MAX_ALTITUDE_M - 100.0).pressure) > float(top.pressure)
-    # −2 km is in the troposphere: T = 288.15 + 6.5e-3·2000·R0/(R0 − 2000)... from H
+    # −2 km is in the troposphere: T = 288.15 − 0.0065·H with H = R0·z/(R0 + z)
     h = R0 * MIN_ALTITUDE_M / (R0 + MIN_ALTITUDE_M)
     assert float(bottom.temperature) == pytest.approx(288.15 - 0.0065 * h, abs=1e-9)
 

@@ -82,6 +82,8 @@ def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     if len(rows) < 2:
         raise ThrustCurveError(f"{path}: fewer than two thrust points")
     t, f = np.array(rows, dtype=float).T
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(f))):
+        raise ThrustCurveError(f"{path}: times and thrusts must be finite numbers")
     if np.any(np.diff(t) <= 0) or t[0] < 0 or np.any(f < 0):
         raise ThrustCurveError(f"{path}: times must increase from >= 0 and thrust must be >= 0")
     if t[0] > 0:
@@ -111,8 +113,8 @@ def delivered_impulse(motor: Motor, t):
 
 
 def propellant_mass(motor: Motor, t):
-    """Propellant left at simulation time ``t`` [kg]."""
-    return motor.propellant_mass_kg * (1.0 - delivered_impulse(motor, t) / motor.total_impulse_ns)
+    """Propellant left at simulation time ``t`` [kg] (clamped at 0 against rounding after burnout)."""
+    return jnp.maximum(motor.propellant_mass_kg * (1.0 - delivered_impulse(motor, t) / motor.total_impulse_ns), 0.0)
 
 
 def grain_inertia(motor: Motor, m_prop):
