@@ -51,7 +51,7 @@ def compile_chunk(campaign: Campaign, chunk_size: int) -> Callable:
     def chunk(master_key, indices):
         return jax.vmap(lambda i: realization(campaign, settings, master_key, i))(indices)
 
-    devices = [d for d in jax.local_devices()][: max(1, math.gcd(chunk_size, jax.local_device_count()))]
+    devices = jax.local_devices()[: math.gcd(chunk_size, jax.local_device_count())]
     mesh = jax.sharding.Mesh(np.array(devices), ("batch",))
     P = jax.sharding.PartitionSpec
     sharded = jax.shard_map(chunk, mesh=mesh, in_specs=(P(), P("batch")), out_specs=P("batch"))
