@@ -108,8 +108,9 @@ def delivered_impulse(motor: Motor, t):
     tau = jnp.clip(t - motor.ignition_time_s, 0.0, motor.burn_time_s)
     k = motor.time_s.shape[0]
     i = jnp.clip(jnp.searchsorted(motor.time_s, tau, side="right", method="compare_all") - 1, 0, k - 2)
-    f_tau = interp1d(tau, motor.time_s, motor.thrust_n)
-    return motor.impulse_ns[i] + 0.5 * (tau - motor.time_s[i]) * (motor.thrust_n[i] + f_tau)
+    t0, t1, f0, f1 = motor.time_s[i], motor.time_s[i + 1], motor.thrust_n[i], motor.thrust_n[i + 1]
+    f_tau = f0 + (tau - t0) / (t1 - t0) * (f1 - f0)  # thrust at tau, from the segment already found
+    return motor.impulse_ns[i] + 0.5 * (tau - t0) * (f0 + f_tau)
 
 
 def propellant_mass(motor: Motor, t):
