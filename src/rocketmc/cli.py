@@ -1,4 +1,5 @@
-"""The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file."""
+"""The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``aero
+derivatives`` of a rocket."""
 
 from __future__ import annotations
 
@@ -17,7 +18,9 @@ def _run(args) -> int:
     from .campaign import ConfigError, ResultWriter, load_campaign, run_chunks
 
     try:
-        campaign = load_campaign(args.campaign).with_overrides(n_realizations=args.n, seed=args.seed)
+        campaign = load_campaign(args.campaign).with_overrides(
+            n_realizations=args.n, seed=args.seed, aero_model=args.aero_model
+        )
     except ConfigError as e:
         print(f"rocketmc: error: {args.campaign}: {e}", file=sys.stderr)
         return 2
@@ -62,6 +65,73 @@ def _report(args) -> int:
     return 0
 
 
+def _rocket_campaign(rocket: str):
+    """The campaign file ``rocket``, or a minimal campaign around the preset of that name."""
+    from .campaign import load_campaign, parse_campaign
+
+    if rocket.endswith(".toml"):
+        return load_campaign(rocket)
+    return parse_campaign(
+        f'name = "{rocket}"\nn_realizations = 1\nseed = 0\n[rocket]\npreset = "{rocket}"\n'
+        "[site]\nlatitude_deg = 0.0\nlongitude_deg = 0.0\naltitude_m = 0.0\n"
+        "[launch]\nrail_length_m = 1.0\nelevation_deg = 90.0\nazimuth_deg = 0.0\n"
+    )
+
+
+def _aero_derivatives(args) -> int:
+    from .aero.model import LinearAero, linear_derivatives, simplify
+    from .campaign import ConfigError
+    from .campaign.model import nominal_params
+    from .sim.flight import mass_properties
+
+    try:
+        campaign = _rocket_campaign(args.rocket)
+    except ConfigError as e:
+        print(f"rocketmc: error: {args.rocket}: {e}", file=sys.stderr)
+        return 2
+    params = nominal_params(campaign)
+    aero = params.rocket.aero
+    linear = aero if isinstance(aero, LinearAero) else simplify(aero)
+    c = linear_derivatives(linear, args.mach, args.altitude)
+    reference_point = campaign.config.rocket.reference_point_m
+    d = float(linear.reference_length_m)
+    moment_reference = reference_point - float(linear.moment_ref_x_m)
+    cp = moment_reference - c["Cma"] * d / c["CNa"]
+    motor = params.rocket.motor
+    cg = {
+        when: reference_point - float(mass_properties(params, t).cg_x)
+        for when, t in (("liftoff", 0.0), ("burnout", float(motor.ignition_time_s + motor.burn_time_s)))
+    }
+    result = {
+        "rocket": args.rocket,
+        "model": campaign.config.rocket.aero.model,
+        "mach": args.mach,
+        "altitude_m": args.altitude,
+        "reference_area_m2": float(linear.reference_area_m2),
+        "reference_length_m": d,
+        "moment_reference_m": moment_reference,
+        "coefficients_per_rad": c,
+        "center_of_pressure_m": cp,
+        "center_of_mass_m": cg,
+        "static_margin_calibers": {when: (cp - x) / d for when, x in cg.items()},
+    }
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    print(f"{args.rocket} ({result['model']} model), Mach {args.mach}, altitude {args.altitude:g} m; "
+          f"per rad, moments about {moment_reference:.3f} m from the nose, rates per ω·d/(2V)")  # fmt: skip
+    rows = [("CA0", c["CA0"]), ("CNα", c["CNa"]), ("Cmα", c["Cma"]), ("CNq", c["CNq"]), ("Cmq", c["Cmq"]),
+            ("Clp", c["Clp"]), ("Cl0", c["Cl0"])]  # fmt: skip
+    if linear.n_canards == 4:
+        rows += [("CN_δ (pitch)", c["CN_pitch"]), ("Cm_δ (pitch)", c["Cm_pitch"]), ("Cl_δ (roll)", c["Cl_roll"])]
+    for name, value in rows:
+        print(f"  {name:<14}{value:>10.3f}")
+    print(f"  centre of pressure {cp:.3f} m from the nose tip")
+    for when, x in cg.items():
+        print(f"  {when:<8} CG {x:.3f} m, static margin {(cp - x) / d:.2f} calibers")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
     from . import __version__
@@ -74,15 +144,24 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
     run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
+    run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
+                     help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
     report = commands.add_parser("report", help="summarize a result file: ellipses and statistics")
     report.add_argument("file", help="HDF5 result file")
     report.add_argument("--plot", help="write the impact plot with 50/95/99 %% ellipses to this PNG")
     report.add_argument("--json", action="store_true", help="print the summary as JSON")
+    aero = commands.add_parser("aero", help="aerodynamic coefficients of a rocket")
+    aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
+    derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")
+    derivatives.add_argument("rocket", help="a preset name (lynx) or a campaign file (its rocket)")
+    derivatives.add_argument("--mach", type=float, default=0.3, help="Mach number (default 0.3)")
+    derivatives.add_argument("--altitude", type=float, default=0.0, help="altitude above sea level [m] (default 0)")
+    derivatives.add_argument("--json", action="store_true", help="print as JSON")
     args = parser.parse_args(argv)
     for name in ("n", "chunk_size"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    return {"run": _run, "report": _report}[args.command](args)
+    return {"run": _run, "report": _report, "aero": _aero_derivatives}[args.command](args)
 
 
 if __name__ == "__main__":

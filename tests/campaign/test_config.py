@@ -25,7 +25,7 @@ def test_shipped_campaigns_load(path):
 def test_preset_and_override():
     campaign = parse_campaign(edited('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = 20.0'))
     assert campaign.nominal["rocket.dry_mass_kg"] == 20.0
-    assert campaign.nominal["rocket.aero.cn_alpha"] == pytest.approx(24.0744)  # untouched preset value
+    assert campaign.nominal["rocket.aero.linear.cn_alpha"] == pytest.approx(24.0744)  # untouched preset value
 
 
 @pytest.mark.parametrize(

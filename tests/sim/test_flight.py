@@ -33,6 +33,7 @@ from rocketmc.sim.flight import (
     rail_start_n,
     simulate_one,
 )
+from rocketmc.math.table import Table
 from rocketmc.sim.params import SimSettings
 
 N_PERIODS = 3000  # control periods flown by `fly`: ~190-200 s with the 0.1 s descent steps, past every landing
@@ -51,12 +52,12 @@ def calm(p):
 
 def vacuum(p):
     """No aerodynamic force or moment and zero canopy drag: thrust and gravity only."""
-    a = p.rocket.aero
-    keep = ("reference_area_m2", "reference_length_m", "moment_ref_x_m", "ca0_mach")
-    zeros = {f.name: getattr(a, f.name) * 0.0 for f in dataclasses.fields(a) if f.name not in keep}
+    is_table = lambda x: isinstance(x, Table)  # noqa: E731
+    zero = lambda x: dataclasses.replace(x, values=x.values * 0.0) if is_table(x) else x  # noqa: E731
+    aero = dataclasses.replace(jax.tree_util.tree_map(zero, p.rocket.aero, is_leaf=is_table), cl0=0.0)
     chutes = tuple(dataclasses.replace(c, cd_s_m2=c.cd_s_m2 * 0.0) for c in p.rocket.parachutes)
     rocket = dataclasses.replace(
-        p.rocket, aero=dataclasses.replace(a, **zeros), parachutes=chutes, canopy_cl_p=p.rocket.canopy_cl_p * 0.0
+        p.rocket, aero=aero, parachutes=chutes, canopy_cl_p=p.rocket.canopy_cl_p * 0.0
     )
     return dataclasses.replace(p, rocket=rocket)
 

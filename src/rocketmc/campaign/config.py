@@ -16,10 +16,19 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry
+from ..aero.io import load_aero
+from ..aero.model import LinearAero, TableAero, simplify
+from ..aero.sources import BUILTIN_TABLES, build_up_tables, with_axial_curve, with_canards
+from ..aero.tables import AeroTables
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
 
 DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
+FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.geometry.", "rocket.aero.")
+"""Numbers that define the body frame or build the aerodynamic tables once per campaign: not
+dispersible, except those of ``DISPERSIBLE_AERO``."""
+DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.linear.")
 ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
 
 
@@ -56,20 +65,27 @@ class MotorConfig(_Strict):
         return self
 
 
-class LinearAeroConfig(_Strict):
-    """Linear aerodynamic coefficients (per rad) at the reference point; see aero/linear.py."""
+def _mach_curve(mach: list[float], values: list[float], names: str) -> None:
+    if len(mach) != len(values):
+        raise ValueError(f"{names} must have the same length")
+    if np.any(np.diff(mach) <= 0):
+        raise ValueError(f"{names.split(' and ')[-1]} must be strictly increasing")
+
+
+class LinearCoefficientsConfig(_Strict):
+    """Linear coefficients per rad about the reference point, per virtual canard command
+    u = (yaw, pitch, roll, squeeze) as in the thesis (aero/model.py, ``from_virtual_commands``);
+    damping per ω·d/(2V)."""
 
     reference_area_m2: Positive
     reference_length_m: Positive
     ca0_mach: list[NonNegative] = Field(min_length=2)
     ca0: list[NonNegative] = Field(min_length=2)
-    drag_scale: Positive = 1.0
     ca_u: list[float] = Field([0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4)
     cn_alpha: float
     cn_delta: float = 0.0
     cm_alpha: float
     cm_delta: float = 0.0
-    cl0: float = 0.0
     cl_delta: float = 0.0
     cy_r: float = 0.0
     cn_q: float = 0.0
@@ -78,11 +94,89 @@ class LinearAeroConfig(_Strict):
 
     @model_validator(mode="after")
     def _mach_table(self):
-        if len(self.ca0) != len(self.ca0_mach):
-            raise ValueError("ca0 and ca0_mach must have the same length")
-        if np.any(np.diff(self.ca0_mach) <= 0):
-            raise ValueError("ca0_mach must be strictly increasing")
+        _mach_curve(self.ca0_mach, self.ca0, "ca0 and ca0_mach")
         return self
+
+
+class AeroConfig(_Strict):
+    """Aerodynamics: which model flies and where its tables come from."""
+
+    model: Literal["interpolated", "simplified", "linear"] = Field(
+        "interpolated",
+        description="interpolated: the tables; simplified: their linearisation at zero angles; "
+        "linear: the coefficients of [aero.linear]",
+    )
+    tables: str = Field(
+        "buildup",
+        description="'buildup' (from [rocket.geometry]), a built-in table name, or a .h5/.csv/.mat file",
+    )
+    reference_area_m2: Positive | None = Field(None, description="for table files that do not state it")
+    reference_length_m: Positive | None = None
+    moment_reference_m: float | None = Field(None, description="from the nose tip; for files that do not state it")
+    cd_mach: list[NonNegative] | None = Field(None, description="Cd-vs-Mach curve replacing the zero-lift axial force")
+    cd: list[NonNegative] | None = None
+    drag_scale: Positive = 1.0
+    cl0: float = Field(0.0, description="rolling-moment offset (fin misalignment)")
+    linear: LinearCoefficientsConfig | None = None
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if (self.cd_mach is None) != (self.cd is None):
+            raise ValueError("cd and cd_mach go together")
+        if self.cd is not None:
+            _mach_curve(self.cd_mach, self.cd, "cd and cd_mach")
+        if self.model == "linear" and self.linear is None:
+            raise ValueError("model = 'linear' needs the coefficients in [rocket.aero.linear]")
+        return self
+
+
+class NoseConfig(_Strict):
+    kind: Literal[NOSE_KINDS]
+    length_m: Positive
+
+
+class FinSetConfig(_Strict):
+    """Trapezoidal panels (aero/geometry.py ``FinSet``); position_m: root leading edge from the nose tip."""
+
+    count: int = Field(ge=1, le=8)
+    root_chord_m: Positive
+    tip_chord_m: NonNegative
+    span_m: Positive
+    sweep_m: float = 0.0
+    position_m: float
+    thickness_m: Positive = 0.005
+    cant_deg: float = Field(0.0, ge=-15, le=15)
+    first_panel_deg: float = 0.0
+
+
+class BoatTailConfig(_Strict):
+    length_m: Positive
+    aft_diameter_m: Positive
+    position_m: float
+
+
+class GeometryConfig(_Strict):
+    """External shape for the aerodynamic build-up; positions from the nose tip, positive aft [m]."""
+
+    body_diameter_m: Positive
+    length_m: Positive
+    nose: NoseConfig
+    fins: list[FinSetConfig] = []
+    canards: FinSetConfig | None = None
+    boat_tail: BoatTailConfig | None = None
+
+    def to_geometry(self) -> RocketGeometry:
+        def fin_set(f: FinSetConfig) -> FinSet:
+            return FinSet(**f.model_dump())
+
+        return RocketGeometry(
+            self.body_diameter_m,
+            self.length_m,
+            Nose(**self.nose.model_dump()),
+            tuple(fin_set(f) for f in self.fins),
+            None if self.canards is None else fin_set(self.canards),
+            None if self.boat_tail is None else BoatTail(**self.boat_tail.model_dump()),
+        )
 
 
 class ParachuteConfig(_Strict):
@@ -107,7 +201,8 @@ class RocketConfig(_Strict):
     rear_lug_m: float
     canopy_roll_damping: float = Field(-5.0, le=0)
     motor: MotorConfig
-    aero: LinearAeroConfig
+    aero: AeroConfig = AeroConfig()
+    geometry: GeometryConfig | None = None
     parachutes: list[ParachuteConfig] = []
 
     @model_validator(mode="after")
@@ -115,6 +210,8 @@ class RocketConfig(_Strict):
         names = [p.name for p in self.parachutes]
         if len(set(names)) != len(names):
             raise ValueError(f"parachute names must be unique, got {names}")
+        if self.aero.model != "linear" and self.aero.tables == "buildup" and self.geometry is None:
+            raise ValueError("aero.tables = 'buildup' needs the rocket's [rocket.geometry]")
         return self
 
 
@@ -205,21 +302,30 @@ class CampaignConfig(_Strict):
 
 @dataclasses.dataclass(frozen=True)
 class Campaign:
-    """A validated campaign: the config, its TOML text, the thrust curve and the nominal values of
-    every dispersible number, keyed by dotted path (``"rocket.dry_mass_kg"``, ``"rocket.aero.ca0.2"``)."""
+    """A validated campaign: the config, its TOML text, the thrust curve, the nominal values of
+    every dispersible number, keyed by dotted path (``"rocket.dry_mass_kg"``, ``"rocket.aero.ca0.2"``),
+    the aerodynamic model with its tables (None for ``model = "linear"``, built per flight) and the
+    folder its relative file names are resolved from."""
 
     config: CampaignConfig
     text: str
     thrust_time_s: np.ndarray
     thrust_n: np.ndarray
     nominal: dict[str, float]
+    aero: TableAero | LinearAero | None
+    base_dir: Path
 
-    def with_overrides(self, n_realizations: int | None = None, seed: int | None = None) -> Campaign:
-        """The same campaign with N and/or the seed replaced (CLI options)."""
-        update = {k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None}
+    def with_overrides(
+        self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None
+    ) -> Campaign:
+        """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options)."""
         data = self.config.model_dump()
-        data.update(update)
-        return dataclasses.replace(self, config=_validate(data))
+        data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
+        if aero_model is None or aero_model == self.config.rocket.aero.model:
+            return dataclasses.replace(self, config=_validate(data))
+        data["rocket"]["aero"]["model"] = aero_model
+        config = _validate(data)
+        return dataclasses.replace(self, config=config, aero=_aero_model(config.rocket, self.base_dir))
 
 
 def _format_error(error: ValidationError) -> str:
@@ -261,14 +367,15 @@ def preset_rocket(name: str) -> dict:
     return tomllib.loads(resource.read_text())
 
 
-def _resolve_thrust_curve(name: str, base_dir: Path) -> Path:
+def _resolve_data_file(name: str, base_dir: Path, folder: str, field: str) -> Path:
+    """``name`` beside the campaign, else in the package's ``data/<folder>``."""
     candidate = base_dir / name
     if candidate.is_file():
         return candidate
-    builtin = resources.files("rocketmc") / "data" / "motors" / name
+    builtin = resources.files("rocketmc") / "data" / folder / name
     if builtin.is_file():
         return Path(str(builtin))
-    raise ConfigError(f"rocket.motor.thrust_curve: file not found: {name!r} (neither beside the campaign nor built in)")
+    raise ConfigError(f"{field}: file not found: {name!r} (neither beside the campaign nor built in)")
 
 
 def flatten_numbers(tree, prefix: str = "") -> dict[str, float]:
@@ -300,6 +407,9 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
     data = config.model_dump(exclude={"dispersions"})
     for path, d in config.dispersions.items():
         field = f"dispersions.{path}"
+        if path.startswith(FIXED_PER_CAMPAIGN) and not path.startswith(DISPERSIBLE_AERO):
+            raise ConfigError(f"{field}: fixed for the whole campaign (it defines the body frame or builds the "
+                              "aerodynamic tables); disperse rocket.aero.drag_scale or rocket.aero.cl0 instead")  # fmt: skip
         if path not in nominal:
             raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
                               f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
@@ -326,7 +436,7 @@ def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
         raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"]), overrides)
     config = _validate(raw)
 
-    path = _resolve_thrust_curve(config.rocket.motor.thrust_curve, base_dir)
+    path = _resolve_data_file(config.rocket.motor.thrust_curve, base_dir, "motors", "rocket.motor.thrust_curve")
     try:
         time_s, thrust_n = read_thrust_curve(path)
     except ThrustCurveError as e:
@@ -341,7 +451,39 @@ def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
     dump = config.model_dump()
     nominal = {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
     _check_dispersions(config, nominal)
-    return Campaign(config, text, time_s, thrust_n, nominal)
+    return Campaign(config, text, time_s, thrust_n, nominal, _aero_model(config.rocket, base_dir), base_dir)
+
+
+def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
+    aero = rocket.aero
+    geometry = None if rocket.geometry is None else rocket.geometry.to_geometry()
+    try:
+        if aero.tables == "buildup":
+            tables = build_up_tables(geometry, rocket.reference_point_m)
+        else:
+            references = {
+                k: v for k in ("reference_area_m2", "reference_length_m", "moment_reference_m")
+                if (v := getattr(aero, k)) is not None
+            }  # fmt: skip
+            tables = BUILTIN_TABLES[aero.tables]() if aero.tables in BUILTIN_TABLES else load_aero(
+                _resolve_data_file(aero.tables, base_dir, "aero", "rocket.aero.tables"), **references
+            )
+            if geometry is not None:
+                tables = with_canards(tables, geometry)
+        if aero.cd is not None:
+            tables = with_axial_curve(tables, aero.cd_mach, aero.cd)
+    except (ValueError, OSError) as err:
+        raise ConfigError(f"rocket.aero.tables: {err}") from None
+    return tables
+
+
+def _aero_model(rocket: RocketConfig, base_dir: Path) -> TableAero | LinearAero | None:
+    """The campaign's aerodynamic model with its nominal scalars (``campaign.model`` replaces the
+    dispersible ones per flight), or None for ``model = 'linear'`` (built per flight)."""
+    if rocket.aero.model == "linear":
+        return None
+    table_aero = TableAero.from_tables(_aero_tables(rocket, base_dir), rocket.reference_point_m)
+    return simplify(table_aero) if rocket.aero.model == "simplified" else table_aero
 
 
 def load_campaign(path: str | Path) -> Campaign:

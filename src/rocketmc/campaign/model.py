@@ -6,11 +6,12 @@ traced arrays for the dispersed ones), so every unit conversion below happens pe
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 
 import jax.numpy as jnp
 
-from ..aero import LinearAero
+from ..aero.model import from_virtual_commands
 from ..dynamics import Motor, Parachute
 from ..dynamics.propulsion import cumulative_impulse
 from ..env import WindLayers
@@ -52,18 +53,23 @@ def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
     )
 
     a = "rocket.aero"
-    n_mach = len(cfg.rocket.aero.ca0_mach)
-    aero = LinearAero(
-        reference_area_m2=v[f"{a}.reference_area_m2"],
-        reference_length_m=v[f"{a}.reference_length_m"],
-        moment_ref_x_m=jnp.zeros_like(ref),
-        ca0_mach=_vector(v, f"{a}.ca0_mach", n_mach),
-        ca0=_vector(v, f"{a}.ca0", n_mach),
-        drag_scale=v[f"{a}.drag_scale"],
-        ca_u=_vector(v, f"{a}.ca_u", 4),
-        **{k: v[f"{a}.{k}"] for k in ("cn_alpha", "cn_delta", "cm_alpha", "cm_delta", "cl0", "cl_delta",
-                                       "cy_r", "cn_q", "cl_p", "cm_q")},
-    )  # fmt: skip
+    if campaign.aero is None:  # model = "linear": the coefficients may be dispersed
+        lin = f"{a}.linear"
+        n_mach = len(cfg.rocket.aero.linear.ca0_mach)
+        aero = from_virtual_commands(
+            reference_area_m2=v[f"{lin}.reference_area_m2"],
+            reference_length_m=v[f"{lin}.reference_length_m"],
+            moment_ref_x_m=jnp.zeros_like(ref),
+            ca0_mach=_vector(v, f"{lin}.ca0_mach", n_mach),
+            ca0=_vector(v, f"{lin}.ca0", n_mach),
+            ca_u=_vector(v, f"{lin}.ca_u", 4),
+            drag_scale=v[f"{a}.drag_scale"],
+            cl0=v[f"{a}.cl0"],
+            **{k: v[f"{lin}.{k}"] for k in ("cn_alpha", "cn_delta", "cm_alpha", "cm_delta", "cl_delta",
+                                             "cy_r", "cn_q", "cl_p", "cm_q")},
+        )  # fmt: skip
+    else:
+        aero = dataclasses.replace(campaign.aero, drag_scale=v[f"{a}.drag_scale"], cl0=v[f"{a}.cl0"])
 
     parachutes = []
     for i, chute in enumerate(cfg.rocket.parachutes):

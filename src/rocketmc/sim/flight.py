@@ -15,15 +15,19 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ..aero import air_data, linear_aero_wrench
+from ..aero import aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
 from ..env import G0, isa, layered_wind
-from ..gnc import mix
 from ..math import Quat, Vec3, rk4_step
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
+
+
+OUTSIDE_TABLES_QBAR_FRACTION = 0.1
+"""A flight is flagged when it leaves the aero tables at a dynamic pressure above this fraction of its
+maximum: near apogee or on the rail the angles are large but the loads are not."""
 
 
 class Status(enum.IntEnum):
@@ -32,6 +36,7 @@ class Status(enum.IntEnum):
     OK = 0
     NON_FINITE = 1
     MAX_TIME = 2
+    OUTSIDE_AERO_TABLES = 3
 
     @property
     def message(self) -> str:
@@ -39,6 +44,10 @@ class Status(enum.IntEnum):
             Status.OK: "ok",
             Status.NON_FINITE: "the state became NaN or infinite; the flight was stopped there",
             Status.MAX_TIME: "not on the ground at the maximum simulated time (raise max_time_s?)",
+            Status.OUTSIDE_AERO_TABLES: (
+                "flew outside the aerodynamic tables' range (values clamped at their edge) at more than "
+                f"{OUTSIDE_TABLES_QBAR_FRACTION:.0%} of its maximum dynamic pressure"
+            ),
         }[self]
 
 
@@ -62,6 +71,7 @@ class Events:
     impact_speed: jnp.ndarray
     max_mach: jnp.ndarray
     max_qbar: jnp.ndarray
+    max_qbar_outside_tables: jnp.ndarray
     non_finite: jnp.ndarray
 
 
@@ -77,11 +87,13 @@ class FlightState:
 
 
 class Diagnostics(NamedTuple):
-    """By-products of the right-hand side: Mach [-], dynamic pressure [Pa], canopy ω² [1/s²]."""
+    """By-products of the right-hand side: Mach [-], dynamic pressure [Pa], canopy ω² [1/s²], and
+    the dynamic pressure if the aerodynamic tables were left (not under a canopy), else 0 [Pa]."""
 
     mach: jnp.ndarray
     qbar: jnp.ndarray
     canopy_stiffness: jnp.ndarray
+    qbar_outside_tables: jnp.ndarray
 
 
 def mass_properties(p: FlightParams, t) -> MassProperties:
@@ -97,8 +109,8 @@ def mass_properties(p: FlightParams, t) -> MassProperties:
     )
 
 
-def derivatives(t, body: RigidBodyState, p: FlightParams, u, events: Events):
-    """State derivative and ``Diagnostics`` at ``t`` under canard commands ``u`` (yaw, pitch, roll, squeeze)."""
+def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, events: Events):
+    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad]."""
     rocket, env = p.rocket, p.environment
     mass = mass_properties(p, t)
     altitude = -body.r_n.z
@@ -122,9 +134,8 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, u, events: Events):
         under_canopy = under_canopy | (fraction > 0.0)
         stiffness = stiffness + drag_n.norm() * jnp.abs(arm_b.x) / mass.iyy
 
-    aero_force_b, aero_moment_b = linear_aero_wrench(
-        rocket.aero, air, omega_b, u, rocket.canopy_cl_p, under_canopy
-    )
+    coefficients, outside_tables = aero_coefficients(rocket.aero, air, omega_b, mass.cg_x, deflections)
+    aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
     force_b = aero_force_b + Vec3(thrust(rocket.motor, t), 0.0, 0.0)
@@ -137,7 +148,8 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, u, events: Events):
     zero = jnp.zeros_like(accel_along)
     on_rail = RigidBodyState(body.v_n, rail * accel_along, Quat(zero, zero, zero, zero), Vec3(zero, zero, zero))
     d_body = tree_where(jnp.isinf(events.rail_exit_time), on_rail, free)
-    return d_body, Diagnostics(air.mach, air.qbar, stiffness)
+    qbar_outside = jnp.where(outside_tables & ~under_canopy, air.qbar, 0.0)
+    return d_body, Diagnostics(air.mach, air.qbar, stiffness, qbar_outside)
 
 
 def _crossing_fraction(g0, g1):
@@ -225,7 +237,8 @@ def update_events(
         rail_exit_time, rail_exit_speed, burnout_time, burnout_altitude, burnout_speed,
         apogee_time, apogee_altitude, apogee_north, apogee_east, tuple(triggers),
         impact_time, impact_north, impact_east, impact_speed,
-        jnp.maximum(ev.max_mach, diag.mach), jnp.maximum(ev.max_qbar, diag.qbar), ev.non_finite,
+        jnp.maximum(ev.max_mach, diag.mach), jnp.maximum(ev.max_qbar, diag.qbar),
+        jnp.maximum(ev.max_qbar_outside_tables, diag.qbar_outside_tables), ev.non_finite,
     )  # fmt: skip
 
 
@@ -236,7 +249,7 @@ def initial_state(p: FlightParams) -> FlightState:
     body = RigidBodyState(rail_start_n(p), Vec3(zero, zero, zero), p.launch.q_nb0, Vec3(zero, zero, zero))
     events = Events(
         inf, zero, inf, zero, zero, inf, zero, zero, zero,
-        tuple(inf for _ in p.rocket.parachutes), inf, zero, zero, zero, zero, zero,
+        tuple(inf for _ in p.rocket.parachutes), inf, zero, zero, zero, zero, zero, zero,
         jnp.zeros_like(zero, dtype=bool),
     )  # fmt: skip
     return FlightState(zero, body, events, zero)
@@ -264,15 +277,14 @@ def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
     return any_open & ~transient
 
 
-def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState) -> FlightState:
-    """One control period: (GNC plugs in here) then RK4 substeps of the rigid body with events.
+def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections) -> FlightState:
+    """One control period with canard deflections δ1..δn [rad] held: RK4 substeps of the rigid body
+    with events (the GNC will compute ``deflections`` from the state).
 
     The period is ``settings.control_dt_s``; in steady descent under canopy it grows up to
     ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ 0.5.
     Each realization keeps its own clock.
     """
-    canards = (0.0, 0.0, 0.0, 0.0)  # fin deflections δ1..δ4 [rad]: held at zero until the controller lands
-    u = mix(*canards)
     stable_period = settings.substeps * 0.5 / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
     descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
     period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
@@ -280,7 +292,7 @@ def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: F
 
     def substep(carry, _):
         t0, body0, events, _ = carry
-        rhs = lambda t, y: derivatives(t, y, p, u, events)  # noqa: E731
+        rhs = lambda t, y: derivatives(t, y, p, deflections, events)  # noqa: E731
         body1, diag = rk4_step(rhs, t0, body0, h)
         body1 = normalize_attitude(body1)
         events = update_events(p, start_n, events, t0, h, body0, body1, diag)
@@ -303,10 +315,11 @@ def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndar
     """
 
     start_n = rail_start_n(p)
+    neutral = jnp.zeros(p.rocket.aero.n_canards)
 
     def block(state):
         def step(s, _):
-            return control_step(p, settings, start_n, s), None
+            return control_step(p, settings, start_n, s, neutral), None
 
         return jax.lax.scan(step, state, None, settings.block_steps)[0]
 
@@ -317,14 +330,20 @@ def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndar
     return flight_summary(p, final)
 
 
-def fly(p: FlightParams, settings: SimSettings, n_periods: int):
+def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=None):
     """Fly ``n_periods`` control periods and return (final state, trajectory): the trajectory is the
     ``FlightState`` after each period, stacked along a leading axis (``trajectory.t`` holds the
-    times, since periods grow in steady descent)."""
+    times, since periods grow in steady descent).
+
+    canard_command: open-loop deflections, a function of time [s] returning δ1..δn [rad] held over
+    each control period (default: neutral).
+    """
     start_n = rail_start_n(p)
+    neutral = jnp.zeros(p.rocket.aero.n_canards)
 
     def step(s, _):
-        s = control_step(p, settings, start_n, s)
+        deflections = neutral if canard_command is None else jnp.asarray(canard_command(s.t), dtype=float)
+        s = control_step(p, settings, start_n, s, deflections)
         return s, s
 
     return jax.lax.scan(step, initial_state(p), None, n_periods)
@@ -353,6 +372,7 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
         "apogee_east_m": when(ev.apogee_time, ev.apogee_east),
         "max_mach": ev.max_mach,
         "max_dynamic_pressure_pa": ev.max_qbar,
+        "max_dynamic_pressure_outside_aero_tables_pa": ev.max_qbar_outside_tables,
         "rail_exit_time_s": when(ev.rail_exit_time, ev.rail_exit_time),
         "rail_exit_speed_mps": when(ev.rail_exit_time, ev.rail_exit_speed),
         "burnout_time_s": when(ev.burnout_time, ev.burnout_time),
@@ -365,5 +385,8 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
     }
     for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
         summary[f"{chute.name}_deploy_time_s"] = when(trigger_time, trigger_time + chute.delay_s)
-    status = jnp.where(ev.non_finite, Status.NON_FINITE, jnp.where(landed, Status.OK, Status.MAX_TIME))
+    outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
+    status = jnp.select(
+        [ev.non_finite, ~landed, outside], [Status.NON_FINITE, Status.MAX_TIME, Status.OUTSIDE_AERO_TABLES], Status.OK
+    )
     return summary, status.astype(jnp.int32)
