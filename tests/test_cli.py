@@ -50,6 +50,10 @@ def test_report_json_and_plot(small_run, tmp_path, capsys):
         ('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = -3.0', "rocket.dry_mass_kg"),
         ("n_realizations = 1000\n", "", "n_realizations"),
         ("seed = 2021", "seed = 2021\ncolour = 'red'", "colour"),
+        ('preset = "lynx"', 'preset = "lynx"\naero = { tables = "missing.h5" }', "rocket.aero.tables"),
+        ('preset = "lynx"', 'preset = "lynx"\naero = { model = "fast" }', "rocket.aero.model"),
+        ("[dispersions]", '[dispersions]\n"rocket.geometry.fins.0.span_m" = { dist = "normal", std = 0.01 }',
+         "rocket.geometry.fins.0.span_m"),
     ],
 )
 def test_bad_campaign_exit_2_and_no_file(tmp_path, capsys, old, new, field):
@@ -70,3 +74,19 @@ def test_bad_arguments_exit_2(tmp_path, capsys):
     assert main(["report", str(tmp_path / "missing.h5")]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 3 and "--n" in lines[0] and all("not found" in line for line in lines[1:]), lines
+
+
+def test_aero_derivatives(capsys):
+    """The simplified model of the Lynx build-up at Mach 0.3: the printed and JSON forms agree, the
+    centre of pressure follows from Cmα/CNα, and the rocket is statically stable."""
+    assert main(["aero", "derivatives", "lynx", "--mach", "0.3", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    c = result["coefficients_per_rad"]
+    assert c["CNa"] > 0 and c["Cma"] < 0 and c["Cmq"] < 0 and c["Clp"] < 0
+    assert c["CN_pitch"] > 0 and c["Cm_pitch"] > 0 and c["Cl_roll"] > 0  # the thesis's signs
+    d, x_ref = result["reference_length_m"], result["moment_reference_m"]
+    assert result["center_of_pressure_m"] == pytest.approx(x_ref - c["Cma"] * d / c["CNa"], rel=1e-12)
+    assert 0 < result["static_margin_calibers"]["liftoff"] < result["static_margin_calibers"]["burnout"]
+    assert main(["aero", "derivatives", "lynx", "--mach", "0.3"]) == 0
+    text = capsys.readouterr().out
+    assert f"{c['CNa']:.3f}" in text and "static margin" in text

@@ -23,6 +23,7 @@ from rocketmc.campaign.sampling import realization_key, sample_dispersions
 from rocketmc.dynamics import RigidBodyState
 from rocketmc.env import G0, isa
 from rocketmc.math import Vec3
+from rocketmc.math.table import Table
 from rocketmc.sim.flight import (
     Status,
     derivatives,
@@ -33,7 +34,6 @@ from rocketmc.sim.flight import (
     rail_start_n,
     simulate_one,
 )
-from rocketmc.math.table import Table
 from rocketmc.sim.params import SimSettings
 
 N_PERIODS = 3000  # control periods flown by `fly`: ~190-200 s with the 0.1 s descent steps, past every landing

@@ -21,10 +21,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..gnc.allocation import allocate, mix
 from ..math import Vec3
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
-from ..gnc.allocation import allocate, mix
 from .airdata import AirData
 from .tables import BODY_COEFFS, PANEL_COEFFS, AeroTables
 
@@ -262,10 +262,11 @@ def simplify(aero: TableAero) -> LinearAero:
         return jnp.stack(table_coefficients(unit, air, omega_hat, unit.moment_ref_x_m, deflections)[0])
 
     def derivatives(mach, altitude):
-        zero3 = Vec3(0.0, 0.0, 0.0)
-        at = lambda alpha=0.0, beta=0.0, omega=zero3, delta=jnp.zeros(n): coefficients(  # noqa: E731
-            mach, altitude, alpha, beta, omega, delta
-        )
+        zero3, neutral = Vec3(0.0, 0.0, 0.0), jnp.zeros(n)
+
+        def at(alpha=0.0, beta=0.0, omega=zero3, delta=neutral):
+            return coefficients(mach, altitude, alpha, beta, omega, delta)
+
         h = 1e-4
         c0 = dict(zip(AeroCoefficients._fields, at()))
         d_alpha = dict(zip(AeroCoefficients._fields, (at(alpha=h) - at(alpha=-h)) / (2 * h)))

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import tomllib
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
+import tomllib
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry

@@ -24,7 +24,6 @@ from ..math import Quat, Vec3, rk4_step
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
 
-
 OUTSIDE_TABLES_QBAR_FRACTION = 0.1
 """A flight is flagged when it leaves the aero tables at a dynamic pressure above this fraction of its
 maximum: near apogee or on the rail the angles are large but the loads are not."""
