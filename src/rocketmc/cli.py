@@ -93,7 +93,8 @@ def _aero_derivatives(args) -> int:
     aero = params.rocket.aero
     linear = aero if isinstance(aero, LinearAero) else simplify(aero)
     c = linear_derivatives(linear, args.mach, args.altitude)
-    reference_point = campaign.config.rocket.reference_point_m
+    rocket = campaign.config.rocket
+    reference_point = rocket.from_nose(rocket.reference_point_m)  # positions below: from the nose tip
     d = float(linear.reference_length_m)
     moment_reference = reference_point - float(linear.moment_ref_x_m)
     cp = moment_reference - c["Cma"] * d / c["CNa"]

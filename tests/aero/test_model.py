@@ -23,6 +23,7 @@ from rocketmc.aero.model import (
 from rocketmc.aero.sources import build_up_tables, with_axial_curve
 from rocketmc.gnc import allocate
 from rocketmc.math import Vec3
+from rocketmc.math.table import Table
 
 REFERENCE_POINT_M = 1.33
 THESIS = dict(
@@ -178,3 +179,26 @@ def test_interpolated_aero_is_a_pytree_with_static_panel_count(interpolated):
     leaves, tree = jax.tree_util.tree_flatten(interpolated)
     assert interpolated.n_canards == 4
     assert dataclasses.is_dataclass(jax.tree_util.tree_unflatten(tree, leaves))
+
+
+def test_power_on_axial_force(interpolated, simplified):
+    """While the motor burns both models add the power-on change ΔCA(Mach), scaled by drag_scale."""
+    increment = Table.from_numpy(([0.0, 1.0],), [[-0.1], [-0.2]], ("mach",), ("dCA",))
+    for aero in (interpolated, simplified):
+        a = dataclasses.replace(aero, power_on_ca=increment, drag_scale=jnp.asarray(1.1))
+        off, _ = aero_coefficients(a, air(mach=0.3), ZERO_RATES, 0.0, jnp.zeros(4), False)
+        on, _ = aero_coefficients(a, air(mach=0.3), ZERO_RATES, 0.0, jnp.zeros(4), True)
+        assert float(on.ca - off.ca) == pytest.approx(1.1 * -0.13, rel=1e-12)  # linear in Mach: exact
+
+
+def test_build_up_rocket_gets_the_power_on_base_drag_change():
+    """A built-up rocket without a Cd curve loses base drag while burning: OpenRocket's power-on
+    base area is the body's minus the motor's, so ΔCA = −base drag × (d_motor/d_body)²."""
+    from rocketmc.aero import drag
+    from rocketmc.campaign import load_campaign
+
+    campaign = load_campaign("campaigns/custom_rocket.toml")
+    increment = campaign.aero.power_on_ca
+    mach = np.asarray(increment.axes[0])
+    expected = -drag.base_drag_coefficient(mach) * (0.075 / 0.127) ** 2
+    np.testing.assert_allclose(np.asarray(increment.values)[:, 0], expected, rtol=1e-9)

@@ -2,6 +2,7 @@
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rocketmc.campaign.config import ConfigError, load_campaign, parse_campaign
@@ -56,3 +57,69 @@ def test_bad_input_names_the_field(text, field, words):
     assert "\n" not in message
     assert message.startswith(field), message
     assert words in message, message
+
+
+def test_tail_to_nose_positions_give_the_same_flight():
+    """The Lynx with every position rewritten tail-to-nose from an origin 3 m aft of the nose tip
+    (RocketPy's convention) gives the same flight parameters: p' = 3 − p for every position."""
+    import jax
+
+    from rocketmc.campaign.model import nominal_params
+
+    origin = 3.0
+    flipped = """
+coordinate_system = "tail_to_nose"
+nose_position_m = 3.0
+reference_point_m = 1.67
+dry_cg_m = 1.67
+rear_lug_m = 1.262
+motor = { nozzle_m = 0.52 }
+
+[[rocket.parachutes]]
+name = "drogue"
+cd = 0.9
+area_m2 = 0.6
+delay_s = 0.5
+opening_time_s = 0.2
+attach_m = 2.28
+
+[[rocket.parachutes]]
+name = "main"
+cd = 0.9
+area_m2 = 10.6
+deploy_altitude_m = 350.0
+delay_s = 1.0
+opening_time_s = 0.7
+attach_m = 2.28
+
+[rocket.geometry]
+fins = [{ count = 4, root_chord_m = 0.35, tip_chord_m = 0.12, span_m = 0.12, sweep_m = 0.23, position_m = 0.855, thickness_m = 0.003 }]
+canards = { count = 4, root_chord_m = 0.150, tip_chord_m = 0.080, span_m = 0.080, sweep_m = 0.035, position_m = 2.675, thickness_m = 0.005 }
+
+"""
+    assert origin - 1.33 == pytest.approx(1.67) and origin - 2.145 == pytest.approx(0.855)
+    reference = nominal_params(parse_campaign(NOMINAL))
+    campaign = parse_campaign(edited('preset = "lynx"', 'preset = "lynx"' + flipped))
+    for a, b in zip(jax.tree_util.tree_leaves(nominal_params(campaign)), jax.tree_util.tree_leaves(reference)):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)  # positions differ by float rounding only
+
+
+def test_motor_dry_mass_joins_the_airframe_by_the_parallel_axis_theorem():
+    """2 kg of the Lynx's dry mass moved into the motor's casing 0.9 m aft of the dry CG, with the
+    airframe's CG moved forward to keep the total: same mass and CG; inertia = the airframe's and
+    the casing's own plus the parallel-axis terms m_a·a² + m_m·b²."""
+    from rocketmc.campaign.model import nominal_params
+
+    reference = nominal_params(parse_campaign(NOMINAL)).rocket
+    m_total, m_motor, arm = 18.362, 2.0, 0.9
+    shift = m_motor * arm / (m_total - m_motor)  # airframe CG forward of 1.33 m
+    split = nominal_params(parse_campaign(edited(
+        'preset = "lynx"',
+        f'preset = "lynx"\ndry_mass_kg = {m_total - m_motor}\ndry_cg_m = {1.33 - shift}\n'
+        f'motor = {{ dry_mass_kg = {m_motor}, dry_cg_m = {1.33 + arm}, dry_inertia_kgm2 = [0.01, 0.2] }}',
+    ))).rocket  # fmt: skip
+    assert float(split.dry_mass_kg) == pytest.approx(m_total, rel=1e-14)
+    assert float(split.dry_cg_x_m) == pytest.approx(float(reference.dry_cg_x_m), abs=1e-12)
+    parallel = (m_total - m_motor) * shift**2 + m_motor * arm**2
+    assert float(split.dry_iyy_kgm2) == pytest.approx(6.436 + 0.2 + parallel, rel=1e-12)
+    assert float(split.dry_ixx_kgm2) == pytest.approx(0.06 + 0.01, rel=1e-12)

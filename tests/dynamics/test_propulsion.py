@@ -236,6 +236,25 @@ def test_csv_with_header_and_explicit_origin(tmp_path):
     np.testing.assert_allclose(cumulative_impulse(t, f), [0.0, 25.0, 50.0], rtol=1e-15)
 
 
+def test_rocksim_rse_reads_the_same_curve_as_the_eng(tmp_path, curve):
+    """The L1350 curve written as RockSim XML (the format ThrustCurve.org serves) reads back the same."""
+    t, f = curve
+    points = "".join(f'<eng-data t="{float(ti)!r}" f="{float(fi)!r}" m="0" cg="0"/>' for ti, fi in zip(t[1:], f[1:]))
+    path = tmp_path / "L1350.rse"
+    path.write_text(f'<engine-database><engine-list><engine code="L1350"><data>{points}</data></engine>'
+                    "</engine-list></engine-database>")  # fmt: skip
+    t_rse, f_rse = read_thrust_curve(path)
+    np.testing.assert_array_equal(t_rse, t)  # repr round-trips floats exactly
+    np.testing.assert_array_equal(f_rse, f)
+    bad = tmp_path / "bad.rse"
+    bad.write_text("<engine-database><engine><data><eng-data t='0.1'/></data></engine></engine-database>")
+    with pytest.raises(ThrustCurveError, match="lacks a numeric t or f"):
+        read_thrust_curve(bad)
+    bad.write_text("not xml <")
+    with pytest.raises(ThrustCurveError, match="RockSim"):
+        read_thrust_curve(bad)
+
+
 @pytest.mark.parametrize("row", ["0.2 nan", "nan 3", "0.2 inf"])
 def test_non_finite_values_raise(tmp_path, row):
     path = tmp_path / "nan.eng"

@@ -60,7 +60,9 @@ class TableAero:
     outputs BODY_COEFFS; canard_table: per-panel ``Table`` over PANEL_AXES with outputs
     PANEL_COEFFS, or None; canard_roll_rad: (n,) panel roll angles; canard_cp_x_m: body-frame x
     where the panels' normal force acts [m]; canard_cp_radius_m: its distance from the axis [m];
-    drag_scale: multiplier on CA [-]; cl0: rolling-moment offset (fin misalignment) [-]."""
+    drag_scale: multiplier on CA [-]; cl0: rolling-moment offset (fin misalignment) [-];
+    power_on_ca: ``Table`` over ``mach`` of the axial-force change while the motor burns (the
+    base drag the exhaust removes), output ``dCA``, or None."""
 
     reference_area_m2: jnp.ndarray
     reference_length_m: jnp.ndarray
@@ -72,6 +74,7 @@ class TableAero:
     canard_cp_radius_m: jnp.ndarray
     drag_scale: jnp.ndarray
     cl0: jnp.ndarray
+    power_on_ca: Table | None = None
 
     @classmethod
     def from_tables(cls, tables: AeroTables, reference_point_m, drag_scale=1.0, cl0=0.0) -> TableAero:
@@ -115,6 +118,7 @@ class LinearAero:
     table: Table
     drag_scale: jnp.ndarray
     cl0: jnp.ndarray
+    power_on_ca: Table | None
     n_canards: int = static_field()
 
 
@@ -154,11 +158,18 @@ def panel_incidences(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m):
     return jnp.arctan2(-(local_y * normal_y + local_z * normal_z), local_x)
 
 
-def table_coefficients(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m, deflections):
+def power_on_axial(aero: TableAero | LinearAero, air: AirData, burning):
+    """Change of CA while the motor burns (0 when not burning or not modelled) [-]."""
+    if aero.power_on_ca is None:
+        return 0.0
+    return jnp.where(burning, _lookup(aero.power_on_ca, air)[0][0], 0.0)
+
+
+def table_coefficients(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m, deflections, burning=False):
     """``AeroCoefficients`` of the interpolated model and whether a table was left (bool).
 
     deflections: (n,) canard deflections δ1..δn [rad], positive pushing the panel along its
-    normal (0, −cos φ, −sin φ).
+    normal (0, −cos φ, −sin φ); burning: the motor is firing (power-on axial force).
     """
     values, out_of_range = _lookup(aero.body, air)
     body = dict(zip(BODY_COEFFS, values))
@@ -179,13 +190,13 @@ def table_coefficients(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m, d
         cn_yaw = cn_yaw + arm * force_y
         out_of_range = out_of_range | jnp.any(panel_out)
     coefficients = AeroCoefficients(
-        aero.drag_scale * ca, cy, cn, cl + aero.cl0, cm, cn_yaw,
+        aero.drag_scale * (ca + power_on_axial(aero, air, burning)), cy, cn, cl + aero.cl0, cm, cn_yaw,
         body["CNq"], body["Cmq"], body["CYr"], body["Cnr"], body["Clp"],
     )  # fmt: skip
     return coefficients, out_of_range
 
 
-def linear_coefficients(aero: LinearAero, air: AirData, deflections):
+def linear_coefficients(aero: LinearAero, air: AirData, deflections, burning=False):
     """``AeroCoefficients`` of the simplified model and whether its table was left (bool)."""
     values, out_of_range = _lookup(aero.table, air)
     n = aero.n_canards
@@ -195,7 +206,7 @@ def linear_coefficients(aero: LinearAero, air: AirData, deflections):
     quadratic = values[k + 5 * n :].reshape(n, n)
     delta = jnp.asarray(deflections)
     d_cy, d_cn, d_cl, d_cm, d_cn_yaw = control @ delta if n else jnp.zeros(5)
-    ca = aero.drag_scale * c["CA0"] + (delta @ quadratic @ delta if n else 0.0)
+    ca = aero.drag_scale * (c["CA0"] + power_on_axial(aero, air, burning)) + (delta @ quadratic @ delta if n else 0.0)
     coefficients = AeroCoefficients(
         ca,
         -c["CNa"] * air.beta + d_cy,
@@ -208,15 +219,16 @@ def linear_coefficients(aero: LinearAero, air: AirData, deflections):
     return coefficients, out_of_range
 
 
-def aero_coefficients(aero: TableAero | LinearAero, air: AirData, omega_b: Vec3, cg_x_m, deflections):
+def aero_coefficients(aero: TableAero | LinearAero, air: AirData, omega_b: Vec3, cg_x_m, deflections, burning=False):
     """``AeroCoefficients`` of either model (chosen statically by its type) and the out-of-range flag.
 
-    omega_b: body rates [rad/s]; cg_x_m: body-frame x of the centre of mass [m].
+    omega_b: body rates [rad/s]; cg_x_m: body-frame x of the centre of mass [m]; burning: the
+    motor is firing.
     """
     if isinstance(aero, LinearAero):
-        return linear_coefficients(aero, air, deflections)
+        return linear_coefficients(aero, air, deflections, burning)
     omega_hat = omega_b * (0.5 * aero.reference_length_m / jnp.maximum(air.airspeed, 1e-3))
-    return table_coefficients(aero, air, omega_hat, cg_x_m, deflections)
+    return table_coefficients(aero, air, omega_hat, cg_x_m, deflections, burning)
 
 
 def aero_wrench(aero: TableAero | LinearAero, c: AeroCoefficients, air: AirData, omega_b: Vec3, canopy_cl_p, under_canopy):
@@ -254,7 +266,7 @@ def simplify(aero: TableAero) -> LinearAero:
         axes["mach"] = aero.canard_table.axes[2]
     grid_names = tuple(name for name in ("mach", "altitude") if name in axes) or ("mach",)
     grid_axes = tuple(np.asarray(axes.get(name, np.array([0.0, 1.0]))) for name in grid_names)
-    unit = jax.tree_util.tree_map(jnp.asarray, TableAero(**{**vars(aero), "drag_scale": 1.0, "cl0": 0.0}))
+    unit = jax.tree_util.tree_map(jnp.asarray, TableAero(**{**vars(aero), "drag_scale": 1.0, "cl0": 0.0, "power_on_ca": None}))
     n = aero.n_canards
 
     def coefficients(mach, altitude, alpha, beta, omega_hat, deflections):
@@ -296,7 +308,7 @@ def simplify(aero: TableAero) -> LinearAero:
     values = np.asarray(values).reshape(mesh[0].shape + (-1,))
     table = Table.from_numpy(grid_axes, values, grid_names, linear_output_names(n))
     return LinearAero(aero.reference_area_m2, aero.reference_length_m, aero.moment_ref_x_m, table,
-                      aero.drag_scale, aero.cl0, n)  # fmt: skip
+                      aero.drag_scale, aero.cl0, aero.power_on_ca, n)  # fmt: skip
 
 
 def from_virtual_commands(
@@ -329,7 +341,7 @@ def from_virtual_commands(
     table = Table((jnp.asarray(ca0_mach, dtype=float),), rows, ("mach",), names)
     as_array = lambda x: jnp.asarray(x, dtype=float)  # noqa: E731
     return LinearAero(as_array(reference_area_m2), as_array(reference_length_m), as_array(moment_ref_x_m), table,
-                      as_array(drag_scale), as_array(cl0), 4)  # fmt: skip
+                      as_array(drag_scale), as_array(cl0), None, 4)  # fmt: skip
 
 
 def linear_derivatives(aero: LinearAero, mach, altitude_m=0.0) -> dict[str, float]:

@@ -113,3 +113,11 @@ def with_axial_curve(tables: AeroTables, mach, cd) -> AeroTables:
     return dataclasses.replace(
         tables, body=dataclasses.replace(body, values=values), source=f"{tables.source}; axial force from a Cd-vs-Mach curve"
     )
+
+
+def power_on_axial_increment(geometry: RocketGeometry, motor_diameter_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """(Mach, ΔCA) the burning motor adds to the build-up's zero-lift axial force: the base drag of
+    the exhaust's area removed, as OpenRocket does (``aero.drag``; altitude does not enter)."""
+    mach = BUILDUP_GRID["mach"]
+    on = drag.zero_lift_axial_coefficient(geometry, mach, 0.0, power_on=True, motor_diameter_m=motor_diameter_m)
+    return mach, on - drag.zero_lift_axial_coefficient(geometry, mach, 0.0)

@@ -19,13 +19,14 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry
 from ..aero.io import load_aero
 from ..aero.model import LinearAero, TableAero, simplify
-from ..aero.sources import BUILTIN_TABLES, build_up_tables, with_axial_curve, with_canards
+from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_increment, with_axial_curve, with_canards
 from ..aero.tables import AeroTables
+from ..math.table import Table
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
 
 DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
-FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.geometry.", "rocket.aero.")
+FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "rocket.geometry.", "rocket.aero.")
 """Numbers that define the body frame or build the aerodynamic tables once per campaign: not
 dispersible, except those of ``DISPERSIBLE_AERO``."""
 DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.linear.")
@@ -45,7 +46,7 @@ NonNegative = Annotated[float, Field(ge=0)]
 
 
 class MotorConfig(_Strict):
-    """Solid motor; positions are distances from the nose tip, positive aft [m]."""
+    """Solid motor; positions in the rocket's coordinates [m]."""
 
     thrust_curve: str = Field(description="RASP .eng or CSV (time s, thrust N); built-in name or path")
     propellant_mass_kg: Positive
@@ -57,6 +58,10 @@ class MotorConfig(_Strict):
     grain_inner_diameter_m: NonNegative
     grain_length_m: Positive
     grain_center_m: float | None = Field(None, description="default: the grain ends at the nozzle exit")
+    dry_mass_kg: NonNegative = Field(0.0, description="casing, nozzle, closures: 0 if the rocket's dry mass has them")
+    dry_inertia_kgm2: list[NonNegative] = Field([0.0, 0.0], min_length=2, max_length=2,
+                                                description="[axial, transverse] about the motor's dry CG")
+    dry_cg_m: float | None = Field(None, description="default: the grain centre")
 
     @model_validator(mode="after")
     def _core_inside_grain(self):
@@ -112,9 +117,10 @@ class AeroConfig(_Strict):
     )
     reference_area_m2: Positive | None = Field(None, description="for table files that do not state it")
     reference_length_m: Positive | None = None
-    moment_reference_m: float | None = Field(None, description="from the nose tip; for files that do not state it")
+    moment_reference_m: float | None = Field(None, description="in the rocket's coordinates; for files that do not state it")
     cd_mach: list[NonNegative] | None = Field(None, description="Cd-vs-Mach curve replacing the zero-lift axial force")
     cd: list[NonNegative] | None = None
+    cd_power_on: list[NonNegative] | None = Field(None, description="Cd at cd_mach while the motor burns")
     drag_scale: Positive = 1.0
     cl0: float = Field(0.0, description="rolling-moment offset (fin misalignment)")
     linear: LinearCoefficientsConfig | None = None
@@ -125,6 +131,8 @@ class AeroConfig(_Strict):
             raise ValueError("cd and cd_mach go together")
         if self.cd is not None:
             _mach_curve(self.cd_mach, self.cd, "cd and cd_mach")
+        if self.cd_power_on is not None and (self.cd is None or len(self.cd_power_on) != len(self.cd)):
+            raise ValueError("cd_power_on needs cd and cd_mach of the same length")
         if self.model == "linear" and self.linear is None:
             raise ValueError("model = 'linear' needs the coefficients in [rocket.aero.linear]")
         return self
@@ -136,7 +144,7 @@ class NoseConfig(_Strict):
 
 
 class FinSetConfig(_Strict):
-    """Trapezoidal panels (aero/geometry.py ``FinSet``); position_m: root leading edge from the nose tip."""
+    """Trapezoidal panels (aero/geometry.py ``FinSet``); position_m: the root's leading edge."""
 
     count: int = Field(ge=1, le=8)
     root_chord_m: Positive
@@ -156,7 +164,7 @@ class BoatTailConfig(_Strict):
 
 
 class GeometryConfig(_Strict):
-    """External shape for the aerodynamic build-up; positions from the nose tip, positive aft [m]."""
+    """External shape for the aerodynamic build-up; positions in the rocket's coordinates [m]."""
 
     body_diameter_m: Positive
     length_m: Positive
@@ -165,9 +173,11 @@ class GeometryConfig(_Strict):
     canards: FinSetConfig | None = None
     boat_tail: BoatTailConfig | None = None
 
-    def to_geometry(self) -> RocketGeometry:
+    def to_geometry(self, from_nose=lambda position_m: position_m) -> RocketGeometry:
+        """The ``RocketGeometry``; ``from_nose`` maps a position to the distance from the nose tip."""
+
         def fin_set(f: FinSetConfig) -> FinSet:
-            return FinSet(**f.model_dump())
+            return FinSet(**{**f.model_dump(), "position_m": from_nose(f.position_m)})
 
         return RocketGeometry(
             self.body_diameter_m,
@@ -175,7 +185,8 @@ class GeometryConfig(_Strict):
             Nose(**self.nose.model_dump()),
             tuple(fin_set(f) for f in self.fins),
             None if self.canards is None else fin_set(self.canards),
-            None if self.boat_tail is None else BoatTail(**self.boat_tail.model_dump()),
+            None if self.boat_tail is None
+            else BoatTail(**{**self.boat_tail.model_dump(), "position_m": from_nose(self.boat_tail.position_m)}),
         )
 
 
@@ -192,9 +203,13 @@ class ParachuteConfig(_Strict):
 
 
 class RocketConfig(_Strict):
-    """The rocket; positions are distances from the nose tip, positive aft [m]."""
+    """The rocket. Positions [m] are coordinates along the axis in ``coordinate_system``:
+    ``nose_to_tail`` (positive aft) or ``tail_to_nose`` (positive forward, RocketPy's default),
+    from an origin of the user's choice where the nose tip is at ``nose_position_m``."""
 
-    reference_point_m: float
+    coordinate_system: Literal["nose_to_tail", "tail_to_nose"] = "nose_to_tail"
+    nose_position_m: float = 0.0
+    reference_point_m: float = Field(description="origin of the body frame and, by default, the moment reference")
     dry_mass_kg: Positive
     dry_cg_m: float
     dry_inertia_kgm2: list[Positive] = Field(min_length=2, max_length=2, description="[axial, transverse]")
@@ -204,6 +219,15 @@ class RocketConfig(_Strict):
     aero: AeroConfig = AeroConfig()
     geometry: GeometryConfig | None = None
     parachutes: list[ParachuteConfig] = []
+
+    @property
+    def position_sign(self) -> float:
+        """+1 if positions grow aft, −1 if they grow toward the nose."""
+        return 1.0 if self.coordinate_system == "nose_to_tail" else -1.0
+
+    def from_nose(self, position_m: float) -> float:
+        """Distance from the nose tip, positive aft, of a position in the rocket's coordinates [m]."""
+        return self.position_sign * (position_m - self.nose_position_m)
 
     @model_validator(mode="after")
     def _unique_names(self):
@@ -456,15 +480,16 @@ def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
 
 def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
     aero = rocket.aero
-    geometry = None if rocket.geometry is None else rocket.geometry.to_geometry()
+    geometry = None if rocket.geometry is None else rocket.geometry.to_geometry(rocket.from_nose)
     try:
         if aero.tables == "buildup":
-            tables = build_up_tables(geometry, rocket.reference_point_m)
+            tables = build_up_tables(geometry, rocket.from_nose(rocket.reference_point_m))
         else:
             references = {
-                k: v for k in ("reference_area_m2", "reference_length_m", "moment_reference_m")
-                if (v := getattr(aero, k)) is not None
+                k: v for k in ("reference_area_m2", "reference_length_m") if (v := getattr(aero, k)) is not None
             }  # fmt: skip
+            if aero.moment_reference_m is not None:
+                references["moment_reference_m"] = rocket.from_nose(aero.moment_reference_m)
             tables = BUILTIN_TABLES[aero.tables]() if aero.tables in BUILTIN_TABLES else load_aero(
                 _resolve_data_file(aero.tables, base_dir, "aero", "rocket.aero.tables"), **references
             )
@@ -477,12 +502,28 @@ def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
     return tables
 
 
+def _power_on_table(rocket: RocketConfig) -> Table | None:
+    """ΔCA(Mach) while the motor burns: ``cd_power_on − cd`` if given, else the build-up's (the
+    exhaust area taken as the nominal grain's outer diameter) when the tables are built up and no
+    Cd curve replaces them, else None (no power-on effect)."""
+    aero = rocket.aero
+    if aero.cd_power_on is not None:
+        mach, increment = aero.cd_mach, np.subtract(aero.cd_power_on, aero.cd)
+    elif aero.tables == "buildup" and aero.cd is None:
+        geometry = rocket.geometry.to_geometry(rocket.from_nose)
+        mach, increment = power_on_axial_increment(geometry, rocket.motor.grain_outer_diameter_m)
+    else:
+        return None
+    return Table.from_numpy((mach,), np.asarray(increment)[:, None], ("mach",), ("dCA",))
+
+
 def _aero_model(rocket: RocketConfig, base_dir: Path) -> TableAero | LinearAero | None:
     """The campaign's aerodynamic model with its nominal scalars (``campaign.model`` replaces the
     dispersible ones per flight), or None for ``model = 'linear'`` (built per flight)."""
     if rocket.aero.model == "linear":
         return None
-    table_aero = TableAero.from_tables(_aero_tables(rocket, base_dir), rocket.reference_point_m)
+    table_aero = TableAero.from_tables(_aero_tables(rocket, base_dir), rocket.from_nose(rocket.reference_point_m))
+    table_aero = dataclasses.replace(table_aero, power_on_ca=_power_on_table(rocket))
     return simplify(table_aero) if rocket.aero.model == "simplified" else table_aero
 
 

@@ -14,6 +14,7 @@ import jax.numpy as jnp
 from ..aero.model import from_virtual_commands
 from ..dynamics import Motor, Parachute
 from ..dynamics.propulsion import cumulative_impulse
+from ..dynamics.rigid_body import combine_on_axis
 from ..env import WindLayers
 from ..sim.params import Environment, FlightParams, Launch, Rocket
 from .config import Campaign
@@ -29,8 +30,10 @@ def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
     v = {k: jnp.asarray(x, dtype=float) for k, x in values.items()}
     ref = v["rocket.reference_point_m"]
 
-    def body_x(path):  # distance from the nose tip (aft) -> body-frame x (forward) from the reference
-        return ref - v[path]
+    sign = cfg.rocket.position_sign
+
+    def body_x(path):  # a position in the rocket's coordinates -> body-frame x (forward) from the reference
+        return sign * (ref - v[path])
 
     m = "rocket.motor"
     grain_center = (
@@ -38,6 +41,7 @@ def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
         if cfg.rocket.motor.grain_center_m is not None
         else body_x(f"{m}.nozzle_m") + 0.5 * v[f"{m}.grain_length_m"]
     )
+    motor_dry_x = grain_center if cfg.rocket.motor.dry_cg_m is None else body_x(f"{m}.dry_cg_m")
     thrust_n = jnp.asarray(campaign.thrust_n) * v[f"{m}.thrust_scale"]
     motor = Motor(
         time_s=jnp.asarray(campaign.thrust_time_s),
@@ -86,11 +90,15 @@ def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
             )
         )
 
+    dry = combine_on_axis([
+        (v["rocket.dry_mass_kg"], body_x("rocket.dry_cg_m"), v["rocket.dry_inertia_kgm2.0"], v["rocket.dry_inertia_kgm2.1"]),
+        (v[f"{m}.dry_mass_kg"], motor_dry_x, v[f"{m}.dry_inertia_kgm2.0"], v[f"{m}.dry_inertia_kgm2.1"]),
+    ])  # fmt: skip
     rocket = Rocket(
-        dry_mass_kg=v["rocket.dry_mass_kg"],
-        dry_cg_x_m=body_x("rocket.dry_cg_m"),
-        dry_ixx_kgm2=v["rocket.dry_inertia_kgm2.0"],
-        dry_iyy_kgm2=v["rocket.dry_inertia_kgm2.1"],
+        dry_mass_kg=dry.mass,
+        dry_cg_x_m=dry.cg_x,
+        dry_ixx_kgm2=dry.ixx,
+        dry_iyy_kgm2=dry.iyy,
         rear_lug_x_m=body_x("rocket.rear_lug_m"),
         motor=motor,
         aero=aero,

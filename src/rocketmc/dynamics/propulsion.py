@@ -9,6 +9,7 @@ propellant inertia; its centre of mass stays at the grain centre.
 from __future__ import annotations
 
 from pathlib import Path
+from xml.etree import ElementTree
 
 import jax.numpy as jnp
 import numpy as np
@@ -55,15 +56,23 @@ class ThrustCurveError(ValueError):
     """A thrust curve file that cannot be read."""
 
 
-def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Read a RASP ``.eng`` file or a two-column CSV (time [s], thrust [N]).
+def _rse_rows(path: Path) -> list[tuple[float, float]]:
+    """(time, thrust) of the first engine of a RockSim ``.rse`` file (``<eng-data t= f=>``)."""
+    try:
+        root = ElementTree.parse(path).getroot()
+    except ElementTree.ParseError as err:
+        raise ThrustCurveError(f"{path}: not a readable RockSim .rse file ({err})") from None
+    engine = root.find(".//engine")
+    if engine is None:
+        raise ThrustCurveError(f"{path}: no <engine> element")
+    try:
+        return [(float(p.attrib["t"]), float(p.attrib["f"])) for p in engine.iter("eng-data")]
+    except (KeyError, ValueError):
+        raise ThrustCurveError(f"{path}: an <eng-data> point lacks a numeric t or f") from None
 
-    Returns (time, thrust) arrays starting at (0, 0): RASP curves leave the ignition point
-    implicit, so it is added when the first time is positive.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise ThrustCurveError(f"thrust curve file not found: {path}")
+
+def _text_rows(path: Path) -> list[tuple[float, float]]:
+    """(time, thrust) of a RASP ``.eng`` file (its first non-comment line is the header) or a CSV."""
     rows = []
     header_seen = path.suffix.lower() != ".eng"
     for line in path.read_text().splitlines():
@@ -79,6 +88,19 @@ def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
         except (ValueError, IndexError):
             if rows:  # a CSV header is allowed only before the data
                 raise ThrustCurveError(f"{path}: cannot read the line {line!r}") from None
+    return rows
+
+
+def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """Read a RASP ``.eng``, a RockSim ``.rse`` or a two-column CSV (time [s], thrust [N]).
+
+    Returns (time, thrust) arrays starting at (0, 0): RASP curves leave the ignition point
+    implicit, so it is added when the first time is positive.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ThrustCurveError(f"thrust curve file not found: {path}")
+    rows = _rse_rows(path) if path.suffix.lower() == ".rse" else _text_rows(path)
     if len(rows) < 2:
         raise ThrustCurveError(f"{path}: fewer than two thrust points")
     t, f = np.array(rows, dtype=float).T

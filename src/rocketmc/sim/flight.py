@@ -133,11 +133,12 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, events: E
         under_canopy = under_canopy | (fraction > 0.0)
         stiffness = stiffness + drag_n.norm() * jnp.abs(arm_b.x) / mass.iyy
 
-    coefficients, outside_tables = aero_coefficients(rocket.aero, air, omega_b, mass.cg_x, deflections)
+    thrust_n = thrust(rocket.motor, t)
+    coefficients, outside_tables = aero_coefficients(rocket.aero, air, omega_b, mass.cg_x, deflections, thrust_n > 0.0)
     aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
-    force_b = aero_force_b + Vec3(thrust(rocket.motor, t), 0.0, 0.0)
+    force_b = aero_force_b + Vec3(thrust_n, 0.0, 0.0)
     free = rigid_body_derivatives(body, mass, force_b, force_n, moment_b, G0)
 
     # On the rail: motion along it only, no rotation, no sliding back down before liftoff.
