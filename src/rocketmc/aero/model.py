@@ -137,6 +137,16 @@ def _lookup(table: Table, air: AirData):
     return interpolate(table, tuple(_axis_value(name, air) for name in table.axis_names))
 
 
+def rate_scale(aero: TableAero | LinearAero, air: AirData):
+    """d/(2V) [s], which turns body rates into the non-dimensional ω̂ of the damping derivatives."""
+    return 0.5 * aero.reference_length_m / jnp.maximum(air.airspeed, 1e-3)
+
+
+def panel_normals(aero: TableAero):
+    """(n_y, n_z) of each canard panel's normal (0, −cos φ, −sin φ), along which it pushes."""
+    return -jnp.cos(aero.canard_roll_rad), -jnp.sin(aero.canard_roll_rad)
+
+
 def panel_incidences(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m):
     """Local incidence of each canard panel [rad] (n,): the angle, in the plane normal to the panel,
     of the air the panel meets, with the velocity the body rates add at its centre of pressure.
@@ -145,8 +155,8 @@ def panel_incidences(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m):
     """
     cos_b = jnp.cos(air.beta)
     direction = Vec3(cos_b * jnp.cos(air.alpha), jnp.sin(air.beta), cos_b * jnp.sin(air.alpha))
-    phi = aero.canard_roll_rad
-    span_y, span_z = jnp.sin(phi), -jnp.cos(phi)
+    normal_y, normal_z = panel_normals(aero)
+    span_y, span_z = -normal_z, normal_y  # the span direction (0, sin φ, −cos φ)
     scale = 2.0 / aero.reference_length_m  # ω × r / V = ω̂ × r · 2/d
     arm_x = aero.canard_cp_x_m - cg_x_m
     radius = aero.canard_cp_radius_m
@@ -154,7 +164,6 @@ def panel_incidences(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m):
     local_x = direction.x + scale * radius * (omega_hat.y * span_z - omega_hat.z * span_y)
     local_y = direction.y + scale * (omega_hat.z * arm_x - omega_hat.x * radius * span_z)
     local_z = direction.z + scale * (omega_hat.x * radius * span_y - omega_hat.y * arm_x)
-    normal_y, normal_z = -jnp.cos(phi), -jnp.sin(phi)
     return jnp.arctan2(-(local_y * normal_y + local_z * normal_z), local_x)
 
 
@@ -179,7 +188,7 @@ def table_coefficients(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m, d
         panel = jax.vmap(lambda i, d: interpolate(aero.canard_table, (i, d, air.mach)))
         panel_values, panel_out = panel(incidences, jnp.asarray(deflections))
         panel_cn, panel_ca, panel_cr = (panel_values[:, k] for k in range(len(PANEL_COEFFS)))
-        normal_y, normal_z = -jnp.cos(aero.canard_roll_rad), -jnp.sin(aero.canard_roll_rad)
+        normal_y, normal_z = panel_normals(aero)
         force_y, force_z = jnp.sum(panel_cn * normal_y), jnp.sum(panel_cn * normal_z)
         arm = (aero.canard_cp_x_m - aero.moment_ref_x_m) / aero.reference_length_m
         ca = ca + jnp.sum(panel_ca)
@@ -227,8 +236,7 @@ def aero_coefficients(aero: TableAero | LinearAero, air: AirData, omega_b: Vec3,
     """
     if isinstance(aero, LinearAero):
         return linear_coefficients(aero, air, deflections, burning)
-    omega_hat = omega_b * (0.5 * aero.reference_length_m / jnp.maximum(air.airspeed, 1e-3))
-    return table_coefficients(aero, air, omega_hat, cg_x_m, deflections, burning)
+    return table_coefficients(aero, air, omega_b * rate_scale(aero, air), cg_x_m, deflections, burning)
 
 
 def aero_wrench(aero: TableAero | LinearAero, c: AeroCoefficients, air: AirData, omega_b: Vec3, canopy_cl_p, under_canopy):
@@ -239,7 +247,7 @@ def aero_wrench(aero: TableAero | LinearAero, c: AeroCoefficients, air: AirData,
     """
     s, d = aero.reference_area_m2, aero.reference_length_m
     qs = air.qbar * s
-    rate = 0.5 * d / jnp.maximum(air.airspeed, 1e-3)  # ω̂ = ω·d/(2V)
+    rate = rate_scale(aero, air)
     flying = jnp.where(under_canopy, 0.0, 1.0)
     p_hat, q_hat, r_hat = omega_b.x * rate, omega_b.y * rate, omega_b.z * rate
     force = Vec3(-c.ca, c.cy + c.cy_r * r_hat, -(c.cn + c.cn_q * q_hat)) * (qs * flying)

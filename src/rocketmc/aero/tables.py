@@ -15,6 +15,8 @@ import dataclasses
 
 import numpy as np
 
+from ..math.table import check_grid
+
 BODY_AXES = ("alpha", "beta", "mach", "altitude")
 """Axes a body table may use (a subset, in any order): α, β [rad], Mach [-], altitude above MSL [m]."""
 AXIS_UNITS = {"alpha": "rad", "beta": "rad", "mach": "-", "altitude": "m", "incidence": "rad", "deflection": "rad"}
@@ -39,17 +41,7 @@ class GriddedCoefficients:
     values: np.ndarray
 
     def __post_init__(self):
-        if len(self.axis_names) != len(self.axes):
-            raise ValueError(f"{len(self.axes)} axes but {len(self.axis_names)} axis names {self.axis_names}")
-        for name, axis in zip(self.axis_names, self.axes):
-            axis = np.asarray(axis)
-            if axis.ndim != 1 or axis.size < 2 or not np.all(np.isfinite(axis)) or not np.all(np.diff(axis) > 0):
-                raise ValueError(f"axis {name!r} must be 1-D, finite, strictly increasing, with >= 2 points")
-        grid = tuple(len(a) for a in self.axes)
-        if self.values.shape != grid + (len(self.output_names),):
-            raise ValueError(
-                f"values shape {self.values.shape} must be grid {grid} + ({len(self.output_names)} outputs,)"
-            )
+        check_grid(self.axes, self.values, self.axis_names, self.output_names)
         if not np.all(np.isfinite(self.values)):
             raise ValueError("table values must be finite")
 

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import tomllib
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-import tomllib
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry
@@ -21,9 +21,9 @@ from ..aero.io import load_aero
 from ..aero.model import LinearAero, TableAero, simplify
 from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_increment, with_axial_curve, with_canards
 from ..aero.tables import AeroTables
-from ..math.table import Table
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
+from ..math.table import Table
 
 DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
 FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "rocket.geometry.", "rocket.aero.")

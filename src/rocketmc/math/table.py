@@ -14,6 +14,24 @@ import numpy as np
 from ..pytree import pytree_dataclass, static_field
 
 
+def check_grid(axes, values, axis_names, output_names) -> None:
+    """``ValueError`` naming the offending axis or size unless ``values`` (grid + (n_outputs,)) sits
+    on ``axes`` (1-D, finite, strictly increasing, >= 2 points each)."""
+    if len(axis_names) != len(axes):
+        raise ValueError(f"{len(axes)} axes but {len(axis_names)} axis names {tuple(axis_names)}")
+    for name, a in zip(axis_names, axes):
+        a = np.asarray(a)
+        if a.ndim != 1 or a.size < 2:
+            raise ValueError(f"axis {name!r} must be 1-D with at least 2 points, got shape {a.shape}")
+        if not np.all(np.isfinite(a)) or not np.all(np.diff(a) > 0):
+            raise ValueError(f"axis {name!r} must be finite and strictly increasing")
+    grid = tuple(np.asarray(a).size for a in axes)
+    if values.shape[:-1] != grid or values.ndim != len(axes) + 1:
+        raise ValueError(f"values shape {values.shape} must be grid {grid} + (n_outputs,) for axes {tuple(axis_names)}")
+    if values.shape[-1] != len(output_names):
+        raise ValueError(f"{values.shape[-1]} outputs but {len(output_names)} output names")
+
+
 @pytree_dataclass
 class Table:
     """Gridded vector-valued function: ``values[i_0, ..., i_{D-1}, k]`` at ``(axes[0][i_0], ...)``.
@@ -33,18 +51,7 @@ class Table:
         output_names = tuple(output_names)
         axes = [np.asarray(a, dtype=np.float64) for a in axes]
         values = np.asarray(values, dtype=np.float64)
-        if len(axis_names) != len(axes):
-            raise ValueError(f"{len(axes)} axes but {len(axis_names)} axis names {axis_names}")
-        for name, a in zip(axis_names, axes):
-            if a.ndim != 1 or a.size < 2:
-                raise ValueError(f"axis {name!r} must be 1-D with at least 2 points, got shape {a.shape}")
-            if not np.all(np.isfinite(a)) or not np.all(np.diff(a) > 0):
-                raise ValueError(f"axis {name!r} must be finite and strictly increasing")
-        grid = tuple(a.size for a in axes)
-        if values.shape[:-1] != grid or values.ndim != len(axes) + 1:
-            raise ValueError(f"values shape {values.shape} must be grid {grid} + (n_outputs,) for axes {axis_names}")
-        if values.shape[-1] != len(output_names):
-            raise ValueError(f"{values.shape[-1]} outputs but {len(output_names)} output names")
+        check_grid(axes, values, axis_names, output_names)
         return cls(tuple(jnp.asarray(a) for a in axes), jnp.asarray(values), axis_names, output_names)
 
 
