@@ -1,11 +1,14 @@
 """Campaign validation: each kind of bad input is one line naming the field."""
 
+import tomllib
 from pathlib import Path
 
+import jax
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import ConfigError, load_campaign, parse_campaign
+from rocketmc.campaign.config import ConfigError, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign.model import nominal_params
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 NOMINAL = (CAMPAIGNS / "lynx_nominal.toml").read_text()
@@ -46,9 +49,13 @@ def test_preset_and_override():
         (edited("[dispersions]", '[dispersions]\n"launch.rail_length_m" = { dist = "uniform", low = 4.0 }'), "dispersions.launch.rail_length_m", "needs 'high'"),
         (edited("[dispersions]", '[dispersions]\n"launch.rail_length_m" = { dist = "gauss", std = 1.0 }'), "dispersions.launch.rail_length_m.dist", "normal"),
         (NOMINAL + "\n[[[", "", "not valid TOML"),
+        (edited("severity = 1.0", "severity = 4.0"), "environment.turbulence.severity", "less than or equal to 3"),
+        (edited("values = [0.0, 1.0, 2.0, 3.0]", "values = [0.0, 1.0, 2.0, 5.0]"), "dispersions.environment.turbulence.severity", "out of range"),
+        (edited("[environment.turbulence]", '[environment.wind]\nexponent = 0.2\n\n[environment.turbulence]'), "environment.wind", "'exponent' does not apply to the 'layers' wind model"),
     ],
     ids=["missing", "wrong-type", "unknown-key", "negative-mass", "elevation>90", "negative-wind", "preset",
-         "thrust-file", "isp", "dispersion-path", "dispersion-range", "dispersion-params", "dispersion-kind", "toml"],
+         "thrust-file", "isp", "dispersion-path", "dispersion-range", "dispersion-params", "dispersion-kind", "toml",
+         "severity", "severity-draw", "wind-key"],
 )  # fmt: skip
 def test_bad_input_names_the_field(text, field, words):
     with pytest.raises(ConfigError) as info:
@@ -59,13 +66,15 @@ def test_bad_input_names_the_field(text, field, words):
     assert words in message, message
 
 
+def numeric_leaves(tree):
+    """The leaves of a FlightParams, random keys as their integer data."""
+    as_data = lambda x: jax.random.key_data(x) if jax.dtypes.issubdtype(x.dtype, jax.dtypes.prng_key) else x  # noqa: E731
+    return [as_data(x) for x in jax.tree_util.tree_leaves(tree)]
+
+
 def test_tail_to_nose_positions_give_the_same_flight():
     """The Lynx with every position rewritten tail-to-nose from an origin 3 m aft of the nose tip
     (RocketPy's convention) gives the same flight parameters: p' = 3 − p for every position."""
-    import jax
-
-    from rocketmc.campaign.model import nominal_params
-
     origin = 3.0
     flipped = """
 coordinate_system = "tail_to_nose"
@@ -100,7 +109,7 @@ canards = { count = 4, root_chord_m = 0.150, tip_chord_m = 0.080, span_m = 0.080
     assert origin - 1.33 == pytest.approx(1.67) and origin - 2.145 == pytest.approx(0.855)
     reference = nominal_params(parse_campaign(NOMINAL))
     campaign = parse_campaign(edited('preset = "lynx"', 'preset = "lynx"' + flipped))
-    for a, b in zip(jax.tree_util.tree_leaves(nominal_params(campaign)), jax.tree_util.tree_leaves(reference)):
+    for a, b in zip(numeric_leaves(nominal_params(campaign)), numeric_leaves(reference)):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)  # positions differ by float rounding only
 
 
@@ -108,7 +117,6 @@ def test_motor_dry_mass_joins_the_airframe_by_the_parallel_axis_theorem():
     """2 kg of the Lynx's dry mass moved into the motor's casing 0.9 m aft of the dry CG, with the
     airframe's CG moved forward to keep the total: same mass and CG; inertia = the airframe's and
     the casing's own plus the parallel-axis terms m_a·a² + m_m·b²."""
-    from rocketmc.campaign.model import nominal_params
 
     reference = nominal_params(parse_campaign(NOMINAL)).rocket
     m_total, m_motor, arm = 18.362, 2.0, 0.9
@@ -123,3 +131,36 @@ def test_motor_dry_mass_joins_the_airframe_by_the_parallel_axis_theorem():
     parallel = (m_total - m_motor) * shift**2 + m_motor * arm**2
     assert float(split.dry_iyy_kgm2) == pytest.approx(6.436 + 0.2 + parallel, rel=1e-12)
     assert float(split.dry_ixx_kgm2) == pytest.approx(0.06 + 0.01, rel=1e-12)
+
+
+def with_wind(wind: dict, **environment) -> dict:
+    """The nominal campaign's tables with another mean wind and no wind dispersions."""
+    raw = tomllib.loads(NOMINAL)
+    raw["environment"] = {"wind": wind, **environment}
+    raw["dispersions"] = {k: v for k, v in raw["dispersions"].items() if not k.startswith("environment.")}
+    return raw
+
+
+def test_wind_models_of_a_campaign(tmp_path):
+    """constant, power_law and profile campaigns fly the wind their keys describe (from the west, to the east)."""
+    constant = nominal_params(campaign_from_dict(with_wind({"model": "constant", "speed_mps": 6.0, "from_deg": 270.0})))
+    assert float(constant.environment.wind.velocity_n(3000.0).y) == pytest.approx(6.0, rel=1e-15)
+    power = nominal_params(campaign_from_dict(with_wind({"model": "power_law", "speed_mps": 6.0, "from_deg": 270.0})))
+    assert float(power.environment.wind.velocity_n(640.0).y) == pytest.approx(6.0 * 64.0 ** (1 / 7), rel=1e-14)  # h_ref 10 m
+    (tmp_path / "wind.csv").write_text("altitude_agl_m,speed_mps,from_deg\n0,2,270\n1000,12,270\n")
+    raw = with_wind({"model": "profile", "file": "wind.csv", "speed_scale": 1.5})
+    profile = campaign_from_dict(raw, tmp_path)
+    assert float(nominal_params(profile).environment.wind.velocity_n(500.0).y) == pytest.approx(1.5 * 7.0, rel=1e-14)
+    with pytest.raises(ConfigError, match="^environment.wind.file: file not found"):
+        campaign_from_dict(raw, CAMPAIGNS)
+    with pytest.raises(ConfigError, match="^environment.wind: the 'constant' wind model needs 'from_deg'"):
+        campaign_from_dict(with_wind({"model": "constant", "speed_mps": 6.0}))
+
+
+def test_turbulence_section():
+    """No section: no turbulence (None, no cost). W20 follows the severity unless given."""
+    assert nominal_params(campaign_from_dict(with_wind({}))).environment.turbulence is None
+    turbulence = nominal_params(campaign_from_dict(with_wind({}, turbulence={"severity": 2.0}))).environment.turbulence
+    assert float(turbulence.w20_mps) == pytest.approx(30 * 1852 / 3600, rel=1e-14)  # moderate: 30 kt
+    given = with_wind({}, turbulence={"severity": 2.0, "w20_mps": 4.0})
+    assert float(nominal_params(campaign_from_dict(given)).environment.turbulence.w20_mps) == 4.0

@@ -184,8 +184,9 @@ def test_scaled_thrust_still_burns_its_propellant(lynx_campaign):
     """thrust_scale (a dispersed parameter) scales F and I_tot together: same mass, same burn time."""
     from rocketmc.campaign.model import flight_params
 
-    m = flight_params(lynx_campaign, {**lynx_campaign.nominal, "rocket.motor.thrust_scale": 1.1}).rocket.motor
-    nominal = flight_params(lynx_campaign, lynx_campaign.nominal).rocket.motor
+    key = jax.random.key(0)
+    m = flight_params(lynx_campaign, {**lynx_campaign.nominal, "rocket.motor.thrust_scale": 1.1}, key).rocket.motor
+    nominal = flight_params(lynx_campaign, lynx_campaign.nominal, key).rocket.motor
     assert float(m.total_impulse_ns) == pytest.approx(1.1 * float(nominal.total_impulse_ns), rel=1e-15)
     t_bo = float(m.ignition_time_s + m.burn_time_s)
     assert float(propellant_mass(m, t_bo)) == 0.0

@@ -43,11 +43,18 @@ N_BATCH = 3  # realizations compared under vmap and one at a time
 # ----------------------------------------------------------------------------- parameter variants
 
 
+def still(p):
+    """The same flight without turbulence (same structure, zero intensities): the mean wind only."""
+    t = p.environment.turbulence
+    turbulence = dataclasses.replace(t, severity=t.severity * 0.0, w20_mps=t.w20_mps * 0.0)
+    return dataclasses.replace(p, environment=dataclasses.replace(p.environment, turbulence=turbulence))
+
+
 def calm(p):
-    """The same flight with no wind (same layer structure, zero speeds)."""
-    w = p.environment.wind
+    """The same flight with no wind and no turbulence (same structure, zero speeds and intensities)."""
+    w = still(p).environment.wind
     wind = dataclasses.replace(w, north_mps=w.north_mps * 0.0, east_mps=w.east_mps * 0.0)
-    return dataclasses.replace(p, environment=dataclasses.replace(p.environment, wind=wind))
+    return dataclasses.replace(p, environment=dataclasses.replace(still(p).environment, wind=wind))
 
 
 def vacuum(p):
@@ -101,7 +108,8 @@ def calm_flight(fly_fn, lynx_params):
 
 @pytest.fixture(scope="module")
 def windy_flight(fly_fn, lynx_params):
-    return _fly(fly_fn, lynx_params)
+    """The nominal flight in its layered wind, without turbulence."""
+    return _fly(fly_fn, still(lynx_params))
 
 
 @pytest.fixture(scope="module")
@@ -143,7 +151,7 @@ def test_vacuum_coast_right_hand_side_is_gravity(lynx_params):
     ev = initial_state(p).events
     ev = dataclasses.replace(ev, rail_exit_time=jnp.asarray(0.8))  # off the rail
     body = RigidBodyState(Vec3(10.0, -5.0, -900.0), Vec3(20.0, 30.0, -150.0), p.launch.q_nb0, Vec3(0.0, 0.0, 0.0))
-    d, diag = derivatives(jnp.asarray(10.0), body, p, (0.0, 0.0, 0.0, 0.0), ev)
+    d, diag = derivatives(jnp.asarray(10.0), body, p, (0.0, 0.0, 0.0, 0.0), Vec3.zeros(), ev)
     np.testing.assert_array_equal(np.asarray(d.r_n.to_array()), [20.0, 30.0, -150.0])
     np.testing.assert_array_equal(np.asarray(d.v_n.to_array()), [0.0, 0.0, G0])  # exactly: all other terms are 0·x
     np.testing.assert_array_equal(np.asarray(d.omega_b.to_array()), 0.0)
@@ -419,9 +427,10 @@ def test_vmap_equals_a_loop_of_single_flights(lynx_campaign, settings, simulate_
     draw = jax.jit(lambda i: sample_dispersions(lynx_campaign, realization_key(key, i)))
     for i in range(N_BATCH):
         drawn = draw(jnp.uint32(i))
+        params = flight_params(lynx_campaign, {**lynx_campaign.nominal, **drawn}, realization_key(key, i))
         for name, value in drawn.items():
             assert float(value) == float(batch_drawn[name][i]), name  # integer PRNG: bit-identical
-        summary, status = simulate_fn(flight_params(lynx_campaign, {**lynx_campaign.nominal, **drawn}))
+        summary, status = simulate_fn(params)
         assert int(status) == int(batch_status[i]) == Status.OK
         for name, value in floats(summary).items():
             # Not bit-identical: the batched program is vectorised and fused differently from the
@@ -446,3 +455,31 @@ def test_max_time_status(lynx_params):
     assert s["burnout_time_s"] == pytest.approx(t_bo, abs=1e-12)  # what did happen is recorded
     assert np.isfinite(s["rail_exit_time_s"])
     assert Status(int(status)).message.startswith("not on the ground")
+
+
+def test_outside_atmosphere_status(lynx_params):
+    """An apogee above the standard atmosphere's 47 km top is Status.OUTSIDE_ATMOSPHERE."""
+    state = initial_state(lynx_params)
+    landed = dataclasses.replace(
+        state.events, apogee_time=jnp.asarray(20.0), apogee_altitude=jnp.asarray(1500.0), impact_time=jnp.asarray(90.0)
+    )
+    state = dataclasses.replace(state, events=landed)
+    assert int(flight_summary(lynx_params, state)[1]) == Status.OK
+    env = dataclasses.replace(lynx_params.environment, site_altitude_m=jnp.asarray(46_000.0))  # 47.5 km at apogee
+    high = dataclasses.replace(lynx_params, environment=env)
+    assert int(flight_summary(high, state)[1]) == Status.OUTSIDE_ATMOSPHERE
+
+
+def test_turbulence_changes_the_flight_and_is_reproducible(fly_fn, lynx_params, windy_flight):
+    """The nominal flight has light turbulence: it lands elsewhere than in the mean wind alone; the same
+    key gives the same flight to the bit; another key, another flight."""
+    env = lynx_params.environment
+    rekeyed = dataclasses.replace(env.turbulence, key=jax.random.fold_in(env.turbulence.key, 1))
+    turbulent, again, other = (
+        _fly(fly_fn, dataclasses.replace(lynx_params, environment=dataclasses.replace(env, turbulence=t)))[2]
+        for t in (env.turbulence, env.turbulence, rekeyed)
+    )
+    assert again == turbulent
+    for summary in (windy_flight[2], other):
+        shift = np.hypot(summary["impact_north_m"] - turbulent["impact_north_m"], summary["impact_east_m"] - turbulent["impact_east_m"])
+        assert shift > 1.0  # light gusts move the landing point by metres to hundreds of metres

@@ -2,6 +2,7 @@
 
 from .config import Campaign as Campaign
 from .config import ConfigError as ConfigError
+from .config import campaign_from_dict as campaign_from_dict
 from .config import load_campaign as load_campaign
 from .config import parse_campaign as parse_campaign
 from .model import flight_params as flight_params

@@ -23,6 +23,7 @@ from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_incre
 from ..aero.tables import AeroTables
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
+from ..env.wind import read_wind_profile
 from ..math.table import Table
 
 DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
@@ -258,19 +259,66 @@ class WindLayerConfig(_Strict):
     thickness_m: Positive | None = Field(None, description="not needed for the top layer")
 
 
+WIND_MODEL_FIELDS = {
+    "layers": ("layers",),
+    "constant": ("speed_mps", "from_deg"),
+    "power_law": ("speed_mps", "from_deg", "reference_height_m", "exponent"),
+    "profile": ("file", "speed_scale"),
+}
+"""The keys each wind model reads."""
+WIND_DEFAULTS = {"layers": [{"speed_mps": 0.0, "from_deg": 0.0}], "reference_height_m": 10.0, "exponent": 1.0 / 7.0,
+                 "speed_scale": 1.0}  # fmt: skip
+
+
 class WindConfig(_Strict):
-    layers: list[WindLayerConfig] = Field([WindLayerConfig(speed_mps=0.0, from_deg=0.0)], min_length=1)
+    """The mean wind: ``layers`` (piecewise constant, the default), ``constant``, ``power_law``
+    (speed at a reference height, V ∝ h^exponent) or ``profile`` (a CSV file of altitude, speed and
+    direction, linear in between; ``speed_scale`` multiplies it and can be dispersed)."""
+
+    model: Literal["layers", "constant", "power_law", "profile"] = "layers"
+    layers: list[WindLayerConfig] | None = Field(None, min_length=1)
+    speed_mps: NonNegative | None = Field(None, description="constant wind, or power law at reference_height_m")
+    from_deg: float | None = Field(None, ge=-360, le=720, description="direction the wind blows from")
+    reference_height_m: Positive | None = None
+    exponent: float | None = Field(None, ge=0, le=1, description="power-law exponent (1/7 over open terrain)")
+    file: str | None = Field(None, description="CSV with columns altitude_agl_m (or altitude_msl_m), speed_mps, from_deg")
+    speed_scale: NonNegative | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _defaults_of_model(cls, data):
+        if isinstance(data, dict):
+            used = WIND_MODEL_FIELDS.get(data.get("model", "layers"), ())
+            data = {**{k: v for k, v in WIND_DEFAULTS.items() if k in used}, **data}
+        return data
 
     @model_validator(mode="after")
-    def _thicknesses(self):
-        for i, layer in enumerate(self.layers[:-1]):
+    def _fields_of_model(self):
+        used = WIND_MODEL_FIELDS[self.model]
+        for name in {f for fields in WIND_MODEL_FIELDS.values() for f in fields} - set(used):
+            if getattr(self, name) is not None:
+                raise ValueError(f"'{name}' does not apply to the {self.model!r} wind model (it reads {', '.join(used)})")
+        for name in used:
+            if getattr(self, name) is None:
+                raise ValueError(f"the {self.model!r} wind model needs '{name}'")
+        for i, layer in enumerate((self.layers or [])[:-1]):
             if layer.thickness_m is None:
                 raise ValueError(f"layers.{i}.thickness_m is required below the top layer")
         return self
 
 
+class TurbulenceConfig(_Strict):
+    """Dryden turbulence (MIL-F-8785C): severity 0 none, 1 light, 2 moderate, 3 severe (the high-altitude
+    exceedance curves 10⁻², 10⁻³, 10⁻⁵); w20_mps the wind at 20 ft for the low-altitude intensities,
+    by default 15/30/45 kt from the severity."""
+
+    severity: float = Field(ge=0, le=3)
+    w20_mps: NonNegative | None = None
+
+
 class EnvironmentConfig(_Strict):
     wind: WindConfig = WindConfig()
+    turbulence: TurbulenceConfig | None = None
 
 
 class Dispersion(_Strict):
@@ -328,8 +376,9 @@ class CampaignConfig(_Strict):
 class Campaign:
     """A validated campaign: the config, its TOML text, the thrust curve, the nominal values of
     every dispersible number, keyed by dotted path (``"rocket.dry_mass_kg"``, ``"rocket.aero.ca0.2"``),
-    the aerodynamic model with its tables (None for ``model = "linear"``, built per flight) and the
-    folder its relative file names are resolved from."""
+    the aerodynamic model with its tables (None for ``model = "linear"``, built per flight), the
+    folder its relative file names are resolved from, and the measured wind profile (altitude above
+    ground [m], speed [m/s], from-direction [rad]) when the wind model is ``profile``."""
 
     config: CampaignConfig
     text: str
@@ -338,6 +387,7 @@ class Campaign:
     nominal: dict[str, float]
     aero: TableAero | LinearAero | None
     base_dir: Path
+    wind_profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None
@@ -452,6 +502,13 @@ def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(f"not valid TOML: {e}") from None
+    return campaign_from_dict(raw, base_dir, text)
+
+
+def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") -> Campaign:
+    """Validate a campaign from the tables of a campaign file (e.g. one read with ``tomllib`` and
+    edited); ``text`` is what result files record as the campaign's source."""
+    raw = copy.deepcopy(raw)
     rocket = raw.get("rocket")
     if isinstance(rocket, dict) and "preset" in rocket:
         overrides = {k: v for k, v in rocket.items() if k != "preset"}
@@ -475,7 +532,19 @@ def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
     dump = config.model_dump()
     nominal = {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
     _check_dispersions(config, nominal)
-    return Campaign(config, text, time_s, thrust_n, nominal, _aero_model(config.rocket, base_dir), base_dir)
+    aero = _aero_model(config.rocket, base_dir)
+    return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, _wind_profile(config, base_dir))
+
+
+def _wind_profile(config: CampaignConfig, base_dir: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    wind = config.environment.wind
+    if wind.model != "profile":
+        return None
+    path = _resolve_data_file(wind.file, base_dir, "wind", "environment.wind.file")
+    try:
+        return read_wind_profile(path, config.site.altitude_m)
+    except (ValueError, OSError) as err:
+        raise ConfigError(f"environment.wind.file: {err}") from None
 
 
 def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:

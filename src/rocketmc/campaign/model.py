@@ -9,23 +9,27 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 
+import jax
 import jax.numpy as jnp
 
 from ..aero.model import from_virtual_commands
 from ..dynamics import Motor, Parachute
 from ..dynamics.propulsion import cumulative_impulse
 from ..dynamics.rigid_body import combine_on_axis
-from ..env import WindLayers
+from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
 from ..sim.params import Environment, FlightParams, Launch, Rocket
 from .config import Campaign
+from .sampling import realization_key, stream_key
 
 
-def _vector(values: Mapping, path: str, n: int):
-    return jnp.stack([jnp.asarray(values[f"{path}.{i}"], dtype=float) for i in range(n)])
+def _vector(values: Mapping, path: str, n: int, suffix: str = ""):
+    """The n values at ``path.0<suffix>`` .. ``path.<n-1><suffix>`` as one array."""
+    return jnp.stack([jnp.asarray(values[f"{path}.{i}{suffix}"], dtype=float) for i in range(n)])
 
 
-def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
-    """FlightParams from ``values`` (dotted path -> scalar) and the campaign's static structure."""
+def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
+    """FlightParams from ``values`` (dotted path -> scalar), the realization's ``key`` (the turbulence's
+    noise) and the campaign's static structure."""
     cfg = campaign.config
     v = {k: jnp.asarray(x, dtype=float) for k, x in values.items()}
     ref = v["rocket.reference_point_m"]
@@ -108,20 +112,42 @@ def flight_params(campaign: Campaign, values: Mapping) -> FlightParams:
     launch = Launch.from_angles(
         v["launch.rail_length_m"], jnp.deg2rad(v["launch.elevation_deg"]), jnp.deg2rad(v["launch.azimuth_deg"])
     )
-    layers = cfg.environment.wind.layers
-    w = "environment.wind.layers"
-    bottoms = [jnp.zeros_like(ref)]
-    for i in range(len(layers) - 1):
-        bottoms.append(bottoms[-1] + v[f"{w}.{i}.thickness_m"])
-    wind = WindLayers.from_speed_direction(
-        jnp.stack(bottoms),
-        jnp.stack([v[f"{w}.{i}.speed_mps"] for i in range(len(layers))]),
-        jnp.deg2rad(jnp.stack([v[f"{w}.{i}.from_deg"] for i in range(len(layers))])),
+    environment = Environment(
+        site_altitude_m=jnp.asarray(cfg.site.altitude_m, dtype=float),
+        wind=_wind(campaign, v),
+        turbulence=_turbulence(campaign, v, key),
     )
-    environment = Environment(site_altitude_m=jnp.asarray(cfg.site.altitude_m, dtype=float), wind=wind)
     return FlightParams(rocket, launch, environment)
 
 
+def _wind(campaign: Campaign, v: Mapping):
+    """The mean wind of the campaign's model from the (possibly drawn) values ``v``."""
+    config, w = campaign.config.environment.wind, "environment.wind"
+    if config.model == "layers":
+        n = len(config.layers)
+        bottoms = [jnp.zeros(())]
+        for i in range(n - 1):
+            bottoms.append(bottoms[-1] + v[f"{w}.layers.{i}.thickness_m"])
+        return WindLayers.from_speed_direction(
+            jnp.stack(bottoms), _vector(v, f"{w}.layers", n, ".speed_mps"), jnp.deg2rad(_vector(v, f"{w}.layers", n, ".from_deg"))
+        )
+    if config.model == "constant":
+        return WindLayers.from_speed_direction(
+            jnp.zeros(1), v[f"{w}.speed_mps"][None], jnp.deg2rad(v[f"{w}.from_deg"])[None]
+        )
+    if config.model == "power_law":
+        return PowerLawWind(v[f"{w}.speed_mps"], v[f"{w}.reference_height_m"], v[f"{w}.exponent"], jnp.deg2rad(v[f"{w}.from_deg"]))
+    altitude, speed, from_rad = campaign.wind_profile
+    return WindProfile.from_speed_direction(jnp.asarray(altitude), jnp.asarray(speed) * v[f"{w}.speed_scale"], jnp.asarray(from_rad))
+
+
+def _turbulence(campaign: Campaign, v: Mapping, key) -> Turbulence | None:
+    if campaign.config.environment.turbulence is None:
+        return None
+    t = "environment.turbulence"
+    return Turbulence.from_severity(v[f"{t}.severity"], stream_key(key, t), v.get(f"{t}.w20_mps"))
+
+
 def nominal_params(campaign: Campaign) -> FlightParams:
-    """FlightParams of the nominal (undispersed) flight."""
-    return flight_params(campaign, campaign.nominal)
+    """FlightParams of the nominal (undispersed) flight; its turbulence noise is realization 0's."""
+    return flight_params(campaign, campaign.nominal, realization_key(jax.random.key(campaign.config.seed), 0))

@@ -1,7 +1,8 @@
 """Dispersion sampling: realization ``i`` draws from ``fold_in(master_key, i)`` (pure, jittable).
 
 Each dispersed parameter draws from its own stream, ``fold_in(key_i, crc32(path))``, so adding a
-dispersion to a campaign leaves the draws of the others unchanged.
+dispersion to a campaign leaves the draws of the others unchanged; the turbulence's white noise
+has the stream ``"environment.turbulence"``.
 """
 
 from __future__ import annotations
@@ -19,11 +20,16 @@ def realization_key(master_key, index):
     return jax.random.fold_in(master_key, index)
 
 
+def stream_key(key, name: str):
+    """The key of the random stream ``name`` (a dotted path) of the realization with ``key``."""
+    return jax.random.fold_in(key, zlib.crc32(name.encode()))
+
+
 def sample_dispersions(campaign: Campaign, key) -> dict:
     """Draw every dispersed parameter of one realization: dotted path -> scalar."""
     drawn = {}
     for path, d in campaign.config.dispersions.items():
-        k = jax.random.fold_in(key, zlib.crc32(path.encode()))
+        k = stream_key(key, path)
         if d.dist == "normal":
             mean = campaign.nominal[path] if d.mean is None else d.mean
             x = mean + d.std * jax.random.normal(k)

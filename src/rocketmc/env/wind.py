@@ -1,11 +1,25 @@
-"""Layered wind: piecewise-constant speed and direction per altitude band."""
+"""Mean wind: piecewise-constant layers, a measured profile, or a power-law shear.
+
+Each model is a pytree with ``velocity_n(altitude_agl)`` (the air's velocity [m/s, NED], horizontal)
+and ``jump_altitudes_m()`` (altitudes [m] where the wind jumps, which the descent step must not
+straddle).
+"""
 
 from __future__ import annotations
 
+import csv
+from pathlib import Path
+
 import jax.numpy as jnp
+import numpy as np
 
 from ..math import Vec3
 from ..pytree import pytree_dataclass
+
+
+def _north_east(speed_mps, from_rad):
+    """Velocity components of a wind of ``speed_mps`` blowing *from* ``from_rad`` (clockwise from north)."""
+    return -speed_mps * jnp.cos(from_rad), -speed_mps * jnp.sin(from_rad)
 
 
 @pytree_dataclass
@@ -14,7 +28,8 @@ class WindLayers:
 
     ``bottom_m[k]`` is the lower edge of layer k above ground [m] (``bottom_m[0] = 0``, increasing);
     ``north_mps[k]``, ``east_mps[k]`` the velocity of the air (the direction it blows *to*) [m/s].
-    The top layer extends upward without limit; below ground the first layer applies.
+    The top layer extends upward without limit; below ground the first layer applies. A constant
+    wind is one layer.
     """
 
     bottom_m: jnp.ndarray
@@ -25,15 +40,94 @@ class WindLayers:
     def from_speed_direction(cls, bottom_m, speed_mps, from_rad) -> WindLayers:
         """Layers from speeds [m/s] and meteorological directions (where the wind comes *from*,
         clockwise from north) [rad]."""
-        speed = jnp.asarray(speed_mps)
-        return cls(jnp.asarray(bottom_m), -speed * jnp.cos(from_rad), -speed * jnp.sin(from_rad))
+        north, east = _north_east(jnp.asarray(speed_mps), from_rad)
+        return cls(jnp.asarray(bottom_m), north, east)
+
+    def velocity_n(self, altitude_agl) -> Vec3:
+        north, east = self.north_mps[0], self.east_mps[0]
+        for k in range(1, self.bottom_m.shape[0]):
+            above = altitude_agl >= self.bottom_m[k]
+            north = jnp.where(above, self.north_mps[k], north)
+            east = jnp.where(above, self.east_mps[k], east)
+        return Vec3(north, east, jnp.zeros_like(north))
+
+    def jump_altitudes_m(self) -> list:
+        return [self.bottom_m[k] for k in range(1, self.bottom_m.shape[0])]
 
 
-def layered_wind(layers: WindLayers, altitude_agl) -> Vec3:
-    """Wind velocity ``wind_n`` [m/s] at ``altitude_agl`` [m] (no vertical component)."""
-    north, east = layers.north_mps[0], layers.east_mps[0]
-    for k in range(1, layers.bottom_m.shape[0]):
-        above = altitude_agl >= layers.bottom_m[k]
-        north = jnp.where(above, layers.north_mps[k], north)
-        east = jnp.where(above, layers.east_mps[k], east)
-    return Vec3(north, east, jnp.zeros_like(north))
+@pytree_dataclass
+class WindProfile:
+    """A measured profile: velocity components [m/s] at increasing altitudes above ground [m],
+    linear in between, constant beyond both ends."""
+
+    altitude_m: jnp.ndarray
+    north_mps: jnp.ndarray
+    east_mps: jnp.ndarray
+
+    @classmethod
+    def from_speed_direction(cls, altitude_m, speed_mps, from_rad) -> WindProfile:
+        north, east = _north_east(jnp.asarray(speed_mps), from_rad)
+        return cls(jnp.asarray(altitude_m), north, east)
+
+    def velocity_n(self, altitude_agl) -> Vec3:
+        north = jnp.interp(altitude_agl, self.altitude_m, self.north_mps)
+        east = jnp.interp(altitude_agl, self.altitude_m, self.east_mps)
+        return Vec3(north, east, jnp.zeros_like(north))
+
+    def jump_altitudes_m(self) -> list:
+        return []
+
+
+POWER_LAW_FLOOR_M = 1.0
+"""Below this height [m] the power-law wind is held at its value there (the law is meant for the
+surface layer above the roughness elements, not at z → 0)."""
+
+
+@pytree_dataclass
+class PowerLawWind:
+    """Shear V(h) = V_ref·(h/h_ref)^exponent from one direction: speed_mps at reference_height_m [m]
+    above ground, exponent (1/7 over open terrain), from_rad where it blows from."""
+
+    speed_mps: jnp.ndarray
+    reference_height_m: jnp.ndarray
+    exponent: jnp.ndarray
+    from_rad: jnp.ndarray
+
+    def velocity_n(self, altitude_agl) -> Vec3:
+        height = jnp.maximum(altitude_agl, POWER_LAW_FLOOR_M)
+        north, east = _north_east(self.speed_mps * (height / self.reference_height_m) ** self.exponent, self.from_rad)
+        return Vec3(north, east, jnp.zeros_like(north))
+
+    def jump_altitudes_m(self) -> list:
+        return []
+
+
+def read_wind_profile(path, site_altitude_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(altitude above ground [m], speed [m/s], from-direction [rad]) of a measured profile, on the host.
+
+    The CSV (``#`` comments allowed) has a header naming ``altitude_agl_m`` or ``altitude_msl_m``
+    (the latter made relative to ``site_altitude_m``), ``speed_mps`` and ``from_deg``; altitudes strictly
+    increasing. ``ValueError`` naming what is wrong.
+    """
+    with Path(path).open(newline="") as f:
+        rows = list(csv.DictReader(line for line in f if line.strip() and not line.lstrip().startswith("#")))
+    header = list(rows[0]) if rows else []
+    altitude_columns = [c for c in ("altitude_agl_m", "altitude_msl_m") if c in header]
+    if len(altitude_columns) != 1 or not {"speed_mps", "from_deg"} <= set(header):
+        raise ValueError(f"{path}: expected columns altitude_agl_m (or altitude_msl_m), speed_mps and from_deg, "
+                         f"found {', '.join(header) or 'none'}")  # fmt: skip
+    columns = [altitude_columns[0], "speed_mps", "from_deg"]
+    try:
+        values = np.array([[float(row[c]) for c in columns] for row in rows])
+    except (TypeError, ValueError):
+        raise ValueError(f"{path}: every row needs numbers in {', '.join(columns)}") from None
+    if len(values) < 2 or not np.all(np.isfinite(values)):
+        raise ValueError(f"{path}: needs at least 2 rows of finite numbers in {', '.join(columns)}")
+    altitude, speed, from_deg = values.T
+    if altitude_columns[0] == "altitude_msl_m":
+        altitude = altitude - site_altitude_m
+    if not np.all(np.diff(altitude) > 0):
+        raise ValueError(f"{path}: {altitude_columns[0]} must be strictly increasing")
+    if np.any(speed < 0):
+        raise ValueError(f"{path}: speed_mps must not be negative")
+    return altitude, speed, np.deg2rad(from_deg)

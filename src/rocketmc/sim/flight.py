@@ -19,7 +19,8 @@ from ..aero import aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
-from ..env import G0, isa, layered_wind
+from ..env import G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, isa, turbulence_scales
+from ..env.atmosphere import MAX_ALTITUDE_M
 from ..math import Quat, Vec3, rk4_step
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
@@ -36,6 +37,7 @@ class Status(enum.IntEnum):
     NON_FINITE = 1
     MAX_TIME = 2
     OUTSIDE_AERO_TABLES = 3
+    OUTSIDE_ATMOSPHERE = 4
 
     @property
     def message(self) -> str:
@@ -46,6 +48,10 @@ class Status(enum.IntEnum):
             Status.OUTSIDE_AERO_TABLES: (
                 "flew outside the aerodynamic tables' range (values clamped at their edge) at more than "
                 f"{OUTSIDE_TABLES_QBAR_FRACTION:.0%} of its maximum dynamic pressure"
+            ),
+            Status.OUTSIDE_ATMOSPHERE: (
+                f"climbed above the standard atmosphere's top ({MAX_ALTITUDE_M / 1000:.1f} km above sea level), "
+                "where the air was held at its value there"
             ),
         }[self]
 
@@ -76,13 +82,15 @@ class Events:
 
 @pytree_dataclass
 class FlightState:
-    """Time [s], rigid-body state, the event record, and the squared pendulum rate of the body
-    swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the descent step."""
+    """Time [s], rigid-body state, the event record, the squared pendulum rate of the body
+    swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the descent step, and
+    the turbulence filters (None without turbulence)."""
 
     t: jnp.ndarray
     body: RigidBodyState
     events: Events
     canopy_stiffness: jnp.ndarray
+    turbulence: TurbulenceState | None
 
 
 class Diagnostics(NamedTuple):
@@ -108,14 +116,15 @@ def mass_properties(p: FlightParams, t) -> MassProperties:
     )
 
 
-def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, events: Events):
-    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad]."""
+def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events):
+    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad] and a
+    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind."""
     rocket, env = p.rocket, p.environment
     mass = mass_properties(p, t)
     altitude = -body.r_n.z
     altitude_msl = env.site_altitude_m + altitude
     atmosphere = isa(altitude_msl)
-    wind_n = layered_wind(env.wind, altitude)
+    wind_n = env.wind.velocity_n(altitude) + gust_n
     q_nb, omega_b = body.q_nb, body.omega_b
     air = air_data(q_nb.rotate_inverse(body.v_n - wind_n), atmosphere, altitude_msl)
 
@@ -252,7 +261,8 @@ def initial_state(p: FlightParams) -> FlightState:
         tuple(inf for _ in p.rocket.parachutes), inf, zero, zero, zero, zero, zero, zero,
         jnp.zeros_like(zero, dtype=bool),
     )  # fmt: skip
-    return FlightState(zero, body, events, zero)
+    turbulence = p.environment.turbulence
+    return FlightState(zero, body, events, zero, None if turbulence is None else initial_turbulence(turbulence))
 
 
 def done(state: FlightState):
@@ -271,15 +281,15 @@ def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
         transient = transient | (jnp.isfinite(trigger_time) & (t < settled))
     altitude = -state.body.r_n.z
     reach = jnp.abs(state.body.v_n.z) * settings.descent_dt_s + 1.0
-    bottoms = p.environment.wind.bottom_m
-    for k in range(1, bottoms.shape[0]):
-        transient = transient | (jnp.abs(altitude - bottoms[k]) < reach)
+    for jump_altitude in p.environment.wind.jump_altitudes_m():
+        transient = transient | (jnp.abs(altitude - jump_altitude) < reach)
     return any_open & ~transient
 
 
 def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections) -> FlightState:
-    """One control period with canard deflections δ1..δn [rad] held: RK4 substeps of the rigid body
-    with events (the GNC will compute ``deflections`` from the state).
+    """One control period with canard deflections δ1..δn [rad] and the turbulent gust held: RK4
+    substeps of the rigid body with events (the GNC will compute ``deflections`` from the state),
+    then the turbulence filters advanced over the period.
 
     The period is ``settings.control_dt_s``; in steady descent under canopy it grows up to
     ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ 0.5.
@@ -289,10 +299,17 @@ def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: F
     descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
     period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
     h = period / settings.substeps
+    turbulence = p.environment.turbulence
+    altitude = -state.body.r_n.z
+    mean_wind_n = p.environment.wind.velocity_n(altitude)
+    gust = Vec3.zeros(state.t)
+    if turbulence is not None:
+        scales = turbulence_scales(turbulence, altitude)
+        gust = gust_n(state.turbulence, scales, mean_wind_n, state.body.q_nb)
 
     def substep(carry, _):
         t0, body0, events, _ = carry
-        rhs = lambda t, y: derivatives(t, y, p, deflections, events)  # noqa: E731
+        rhs = lambda t, y: derivatives(t, y, p, deflections, gust, events)  # noqa: E731
         body1, diag = rk4_step(rhs, t0, body0, h)
         body1 = normalize_attitude(body1)
         events = update_events(p, start_n, events, t0, h, body0, body1, diag)
@@ -304,7 +321,11 @@ def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: F
     body = tree_where(done(state) | ~finite, state.body, body)
     events = tree_where(done(state), state.events, events)
     events = dataclasses.replace(events, non_finite=events.non_finite | ~finite)
-    return FlightState(state.t + period, body, events, stiffness)
+    filters = state.turbulence
+    if turbulence is not None:
+        airspeed = (state.body.v_n - mean_wind_n - gust).norm()
+        filters = advance_turbulence(turbulence, filters, scales, airspeed, period)
+    return FlightState(state.t + period, body, events, stiffness, filters)
 
 
 def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
@@ -386,7 +407,10 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
     for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
         summary[f"{chute.name}_deploy_time_s"] = when(trigger_time, trigger_time + chute.delay_s)
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
+    too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
     status = jnp.select(
-        [ev.non_finite, ~landed, outside], [Status.NON_FINITE, Status.MAX_TIME, Status.OUTSIDE_AERO_TABLES], Status.OK
+        [ev.non_finite, ~landed, too_high, outside],
+        [Status.NON_FINITE, Status.MAX_TIME, Status.OUTSIDE_ATMOSPHERE, Status.OUTSIDE_AERO_TABLES],
+        Status.OK,
     )
     return summary, status.astype(jnp.int32)

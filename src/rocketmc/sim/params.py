@@ -8,7 +8,7 @@ import jax.numpy as jnp
 
 from ..aero import LinearAero
 from ..dynamics import Motor, Parachute
-from ..env import WindLayers
+from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass
 
@@ -52,10 +52,12 @@ class Launch:
 
 @pytree_dataclass
 class Environment:
-    """site_altitude_m: pad altitude above mean sea level [m]; wind: layered wind."""
+    """site_altitude_m: pad altitude above mean sea level [m]; wind: the mean wind; turbulence:
+    Dryden gusts added to it (None: no turbulence, and no cost)."""
 
     site_altitude_m: jnp.ndarray
-    wind: WindLayers
+    wind: WindLayers | WindProfile | PowerLawWind
+    turbulence: Turbulence | None = None
 
 
 @pytree_dataclass
