@@ -65,10 +65,11 @@ def main() -> None:
             ax.plot(b_east, b_north, color=color, linewidth=2, label=f"{label}: 95 % ellipse {e.area_m2 / 1e6:.2f} km²")
         (turb, _), (calm, _) = results.values()
         both = (turb["status"] == 0) & (calm["status"] == 0)
-        shift = np.hypot(turb["impact_north_m"] - calm["impact_north_m"], turb["impact_east_m"] - calm["impact_east_m"])[both]
-        print(f"impact shift of the same flight with turbulence: median {np.median(shift):.0f} m, 95th percentile "
-              f"{np.percentile(shift, 95):.0f} m; apogee change {np.mean((turb['apogee_agl_m'] - calm['apogee_agl_m'])[both]):+.1f} m "
-              f"mean, {np.std((turb['apogee_agl_m'] - calm['apogee_agl_m'])[both]):.1f} m std")  # fmt: skip
+        shift = np.hypot(turb["impact_north_m"] - calm["impact_north_m"], turb["impact_east_m"] - calm["impact_east_m"])
+        apogee_change = (turb["apogee_agl_m"] - calm["apogee_agl_m"])[both]
+        print(f"impact shift of the same flight with turbulence: median {np.median(shift[both]):.0f} m, 95th "
+              f"percentile {np.percentile(shift[both], 95):.0f} m; apogee change {np.mean(apogee_change):+.1f} m "
+              f"mean, {np.std(apogee_change):.1f} m std")  # fmt: skip
         ax.plot(0.0, 0.0, "k^", markersize=9, label="pad")
         ax.set_title(f"{raw['name']}: impact points, N = {args.n}")
         ax.set_xlabel("east of pad [m]")

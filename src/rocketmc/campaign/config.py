@@ -281,7 +281,7 @@ class WindConfig(_Strict):
     from_deg: float | None = Field(None, ge=-360, le=720, description="direction the wind blows from")
     reference_height_m: Positive | None = None
     exponent: float | None = Field(None, ge=0, le=1, description="power-law exponent (1/7 over open terrain)")
-    file: str | None = Field(None, description="CSV with columns altitude_agl_m (or altitude_msl_m), speed_mps, from_deg")
+    file: str | None = Field(None, description="CSV: altitude_agl_m (or altitude_msl_m), speed_mps, from_deg")
     speed_scale: NonNegative | None = None
 
     @model_validator(mode="before")
@@ -297,7 +297,9 @@ class WindConfig(_Strict):
         used = WIND_MODEL_FIELDS[self.model]
         for name in {f for fields in WIND_MODEL_FIELDS.values() for f in fields} - set(used):
             if getattr(self, name) is not None:
-                raise ValueError(f"'{name}' does not apply to the {self.model!r} wind model (it reads {', '.join(used)})")
+                raise ValueError(
+                    f"'{name}' does not apply to the {self.model!r} wind model (it reads {', '.join(used)})"
+                )
         for name in used:
             if getattr(self, name) is None:
                 raise ValueError(f"the {self.model!r} wind model needs '{name}'")

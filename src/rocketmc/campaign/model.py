@@ -128,17 +128,17 @@ def _wind(campaign: Campaign, v: Mapping):
         bottoms = [jnp.zeros(())]
         for i in range(n - 1):
             bottoms.append(bottoms[-1] + v[f"{w}.layers.{i}.thickness_m"])
-        return WindLayers.from_speed_direction(
-            jnp.stack(bottoms), _vector(v, f"{w}.layers", n, ".speed_mps"), jnp.deg2rad(_vector(v, f"{w}.layers", n, ".from_deg"))
-        )
+        speeds, directions = _vector(v, f"{w}.layers", n, ".speed_mps"), _vector(v, f"{w}.layers", n, ".from_deg")
+        return WindLayers.from_speed_direction(jnp.stack(bottoms), speeds, jnp.deg2rad(directions))
     if config.model == "constant":
-        return WindLayers.from_speed_direction(
-            jnp.zeros(1), v[f"{w}.speed_mps"][None], jnp.deg2rad(v[f"{w}.from_deg"])[None]
-        )
+        speed, direction = v[f"{w}.speed_mps"][None], jnp.deg2rad(v[f"{w}.from_deg"])[None]
+        return WindLayers.from_speed_direction(jnp.zeros(1), speed, direction)
     if config.model == "power_law":
-        return PowerLawWind(v[f"{w}.speed_mps"], v[f"{w}.reference_height_m"], v[f"{w}.exponent"], jnp.deg2rad(v[f"{w}.from_deg"]))
+        return PowerLawWind(
+            v[f"{w}.speed_mps"], v[f"{w}.reference_height_m"], v[f"{w}.exponent"], jnp.deg2rad(v[f"{w}.from_deg"])
+        )
     altitude, speed, from_rad = campaign.wind_profile
-    return WindProfile.from_speed_direction(jnp.asarray(altitude), jnp.asarray(speed) * v[f"{w}.speed_scale"], jnp.asarray(from_rad))
+    return WindProfile.from_speed_direction(altitude, jnp.asarray(speed) * v[f"{w}.speed_scale"], from_rad)
 
 
 def _turbulence(campaign: Campaign, v: Mapping, key) -> Turbulence | None:

@@ -49,11 +49,11 @@ LOW_ALTITUDE_FLOOR_M = 10.0 * FT  # the low-altitude formulas' lower limit
 
 SEVERITIES = ("none", "light", "moderate", "severe")
 """Severity codes 0..3. Light, moderate, severe: the 10⁻², 10⁻³ and 10⁻⁵ exceedance curves at high
-altitude and W20 = 15, 30, 45 kt at low altitude (MIL-F-8785C §3.7.2.1, §3.7.2.3)."""
+altitude and W20 = 15, 30, 45 kt at low altitude (MIL-F-8785C)."""
 SEVERITY_W20_MPS = tuple(kt * KNOT for kt in (0.0, 15.0, 30.0, 45.0))
 
-# MIL-F-8785C Fig. 10 (as tabulated in JSBSim's FGWinds): σ [ft/s] vs altitude [ft] for the
-# probability-of-exceedance curves 10⁻², 10⁻³, 10⁻⁵, preceded by a zero row for "none".
+# MIL-F-8785C's high-altitude intensity figure (p. 49), as tabulated in JSBSim's FGWinds: σ [ft/s]
+# vs altitude [ft] for the exceedance curves 10⁻², 10⁻³, 10⁻⁵, after a zero row for "none".
 _TABLE_ALTITUDE_FT = (500.0, 1750.0, 3750.0, 7500.0, 15000.0, 25000.0, 35000.0, 45000.0, 55000.0, 65000.0,
                       75000.0, 80000.0)  # fmt: skip
 _TABLE_SIGMA_FTPS = (
