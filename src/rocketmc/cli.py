@@ -1,5 +1,5 @@
 """The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``aero
-derivatives`` of a rocket."""
+derivatives`` of a rocket, ``validate`` the simulation against a real flight."""
 
 from __future__ import annotations
 
@@ -133,6 +133,46 @@ def _aero_derivatives(args) -> int:
     return 0
 
 
+FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
+"""The real flights ``validate`` knows and their built-in campaigns (data/campaigns)."""
+
+
+def _validate(args) -> int:
+    from importlib import resources
+
+    from .analysis.flight_log import load_roccaraso_2021, reduce_flight
+    from .analysis.validation import plot_against_log, validate_euroc, validate_roccaraso
+    from .campaign import ConfigError, load_campaign
+
+    path = args.campaign or Path(str(resources.files("rocketmc") / "data" / "campaigns" / FLIGHTS[args.flight]))
+    try:
+        campaign = load_campaign(path)
+    except ConfigError as e:
+        print(f"rocketmc: error: {path}: {e}", file=sys.stderr)
+        return 2
+    if args.flight == "roccaraso-2021":
+        reduction = reduce_flight(load_roccaraso_2021())
+        checks, flight = validate_roccaraso(campaign, reduction)
+        if args.plot:
+            Path(args.plot).mkdir(parents=True, exist_ok=True)
+            plot_against_log(flight, reduction, Path(args.plot) / "roccaraso_2021.png")
+    else:
+        checks = validate_euroc(campaign)
+    if args.json:
+        print(json.dumps({"flight": args.flight, "campaign": str(path), "checks": [c.to_dict() for c in checks]}, indent=2))
+    else:
+        print(f"{args.flight}: the nominal flight of {campaign.config.name} against the measured one")
+        print(f"  {'':<40}{'simulated':>11}{'measured':>11}{'error':>10}{'bound':>9}")
+        for c in checks:
+            error, bound = (f"{100 * c.error:+.1f} %", f"{100 * c.tolerance:.0f} %" if c.tolerance else "") if c.relative \
+                else (f"{c.error:+.2f} {c.unit}", f"{c.tolerance:g} {c.unit}" if c.tolerance else "")  # fmt: skip
+            verdict = {True: "ok", False: "FAIL", None: ""}[c.passed]
+            print(f"  {c.name + f' [{c.unit}]':<40}{c.simulated:>11.2f}{c.measured:>11.2f}{error:>10}{bound:>9}  {verdict}")
+        if args.plot and args.flight == "roccaraso-2021":
+            print(f"wrote {Path(args.plot) / 'roccaraso_2021.png'}")
+    return 0 if all(c.passed is not False for c in checks) else 1
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
     from . import __version__
@@ -158,11 +198,16 @@ def main(argv: list[str] | None = None) -> int:
     derivatives.add_argument("--mach", type=float, default=0.3, help="Mach number (default 0.3)")
     derivatives.add_argument("--altitude", type=float, default=0.0, help="altitude above sea level [m] (default 0)")
     derivatives.add_argument("--json", action="store_true", help="print as JSON")
+    validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
+    validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
+    validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
+    validate.add_argument("--plot", help="folder for the overlay plots (roccaraso-2021)")
+    validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
     args = parser.parse_args(argv)
     for name in ("n", "chunk_size"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    return {"run": _run, "report": _report, "aero": _aero_derivatives}[args.command](args)
+    return {"run": _run, "report": _report, "aero": _aero_derivatives, "validate": _validate}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -203,6 +203,22 @@ class ParachuteConfig(_Strict):
     attach_m: float
 
 
+class AirbrakesConfig(_Strict):
+    """Extra axial-force coefficient ΔCA (on the aerodynamic reference area) of deployed airbrakes as a
+    schedule of time since motor ignition [s], linear in between, 0 outside."""
+
+    time_s: list[float] = Field(min_length=2)
+    delta_ca: list[NonNegative] = Field(min_length=2)
+
+    @model_validator(mode="after")
+    def _schedule(self):
+        if len(self.time_s) != len(self.delta_ca):
+            raise ValueError(f"time_s and delta_ca need the same length, got {len(self.time_s)} and {len(self.delta_ca)}")
+        if not np.all(np.diff(self.time_s) > 0):
+            raise ValueError("time_s must be strictly increasing")
+        return self
+
+
 class RocketConfig(_Strict):
     """The rocket. Positions [m] are coordinates along the axis in ``coordinate_system``:
     ``nose_to_tail`` (positive aft) or ``tail_to_nose`` (positive forward, RocketPy's default),
@@ -220,6 +236,7 @@ class RocketConfig(_Strict):
     aero: AeroConfig = AeroConfig()
     geometry: GeometryConfig | None = None
     parachutes: list[ParachuteConfig] = []
+    airbrakes: AirbrakesConfig | None = None
 
     @property
     def position_sign(self) -> float:

@@ -109,6 +109,13 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
         parachutes=tuple(parachutes),
         canopy_cl_p=v["rocket.canopy_roll_damping"],
     )
+    if cfg.rocket.airbrakes is not None:
+        n = len(cfg.rocket.airbrakes.time_s)
+        rocket = dataclasses.replace(
+            rocket,
+            airbrake_time_s=_vector(v, "rocket.airbrakes.time_s", n),
+            airbrake_delta_ca=_vector(v, "rocket.airbrakes.delta_ca", n),
+        )
     launch = Launch.from_angles(
         v["launch.rail_length_m"], jnp.deg2rad(v["launch.elevation_deg"]), jnp.deg2rad(v["launch.azimuth_deg"])
     )

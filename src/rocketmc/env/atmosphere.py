@@ -80,3 +80,11 @@ def isa(altitude_msl) -> AtmosphereState:
     )
     density = pressure / (R_AIR * temperature)
     return AtmosphereState(temperature, pressure, density, jnp.sqrt(GAMMA_AIR * R_AIR * temperature))
+
+
+def troposphere_altitude(pressure_pa):
+    """Geometric altitude above mean sea level [m] where the ISA troposphere (below 11 km) has
+    ``pressure_pa`` [Pa]: what a barometer calibrated to the standard atmosphere reads (host or traced)."""
+    lapse = _LAPSE[0]
+    geopotential = T0 / lapse * ((pressure_pa / P0) ** (-R_AIR * lapse / G0) - 1.0)
+    return R_EARTH_GEOPOTENTIAL * geopotential / (R_EARTH_GEOPOTENTIAL - geopotential)

@@ -144,6 +144,10 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
 
     thrust_n = thrust(rocket.motor, t)
     coefficients, outside_tables = aero_coefficients(rocket.aero, air, omega_b, mass.cg_x, deflections, thrust_n > 0.0)
+    if rocket.airbrake_time_s is not None:
+        since_ignition = t - rocket.motor.ignition_time_s
+        delta_ca = jnp.interp(since_ignition, rocket.airbrake_time_s, rocket.airbrake_delta_ca, left=0.0, right=0.0)
+        coefficients = coefficients._replace(ca=coefficients.ca + delta_ca)
     aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)

@@ -19,7 +19,9 @@ class Rocket:
 
     dry_mass_kg: mass without propellant [kg]; dry_cg_x_m: its CG on the body x axis from the
     reference point [m]; dry_ixx_kgm2, dry_iyy_kgm2: its inertia about that CG [kg·m²];
-    rear_lug_x_m: body-frame x of the rear launch lug [m]; canopy_cl_p: roll damping under canopy.
+    rear_lug_x_m: body-frame x of the rear launch lug [m]; canopy_cl_p: roll damping under canopy;
+    airbrake_time_s, airbrake_delta_ca: the airbrakes' extra axial-force coefficient against time since
+    ignition [s] (linear in between, 0 outside), or None without airbrakes.
     """
 
     dry_mass_kg: jnp.ndarray
@@ -31,6 +33,8 @@ class Rocket:
     aero: LinearAero
     parachutes: tuple[Parachute, ...]
     canopy_cl_p: jnp.ndarray
+    airbrake_time_s: jnp.ndarray | None = None
+    airbrake_delta_ca: jnp.ndarray | None = None
 
 
 @pytree_dataclass

@@ -1,0 +1,176 @@
+"""The nominal flight of a campaign as its sensors would see it, for comparison with a flight log.
+
+Times are from motor ignition [s] (the log's liftoff sample: the L1350 lifts the rocket within a
+sample of lighting); heights above the pad [m]; the specific force along the body x axis [m/s²]
+is what an accelerometer on the axis reads (on the rail too).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from ..campaign import Campaign, nominal_params
+from ..campaign.runner import sim_settings
+from ..env import G0, isa
+from ..math import Vec3
+from ..sim.flight import derivatives, flight_summary, fly
+from .flight_log import FlightReduction
+
+
+def simulated_flight(campaign: Campaign, duration_s: float = 150.0) -> tuple[pd.DataFrame, dict, int]:
+    """The campaign's nominal flight sampled every control period until ``duration_s`` after ignition
+    or the impact: a DataFrame (``t_s``, ``altitude_agl_m``, ``vertical_speed_mps``, ``airspeed_mps``,
+    ``axial_specific_force_mps2``), the summary (times from ignition) and the status code."""
+    params = nominal_params(campaign)
+    settings = sim_settings(campaign)
+    ignition = float(params.rocket.motor.ignition_time_s)
+    n_periods = int(np.ceil((duration_s + ignition) / settings.control_dt_s))
+
+    def sensed(p):
+        final, trajectory = fly(p, settings, n_periods)
+        neutral = jnp.zeros(p.rocket.aero.n_canards)
+
+        def at(state):
+            d_body, diagnostics = derivatives(state.t, state.body, p, neutral, Vec3.zeros(state.t), state.events)
+            gravity_free = d_body.v_n - Vec3(0.0, 0.0, G0)
+            return state.body.q_nb.rotate_inverse(gravity_free).x, diagnostics.mach
+
+        force, mach = jax.vmap(at)(trajectory)
+        return final, trajectory, force, mach
+
+    final, trajectory, force, mach = jax.jit(sensed)(params)
+    summary, status = flight_summary(params, final)
+    altitude = -np.asarray(trajectory.body.r_n.z)
+    speed_of_sound = np.asarray(isa(float(params.environment.site_altitude_m) + altitude).speed_of_sound)
+    flight = pd.DataFrame({
+        "t_s": np.asarray(trajectory.t) - ignition,
+        "altitude_agl_m": altitude,
+        "vertical_speed_mps": -np.asarray(trajectory.body.v_n.z),
+        "airspeed_mps": np.asarray(mach) * speed_of_sound,
+        "axial_specific_force_mps2": np.asarray(force),
+    })  # fmt: skip
+    times = {k: float(v) - ignition if k.endswith("time_s") else float(v) for k, v in summary.items()}
+    until = min(duration_s, times["impact_time_s"]) if np.isfinite(times["impact_time_s"]) else duration_s
+    return flight[flight.t_s <= until].reset_index(drop=True), times, int(status)
+
+
+@dataclass(frozen=True)
+class Check:
+    """One simulated figure against the measured one. ``error`` is relative (a fraction) when
+    ``relative`` else in ``unit``; ``tolerance`` bounds |error| (None: reported, not judged)."""
+
+    name: str
+    unit: str
+    simulated: float
+    measured: float
+    error: float
+    relative: bool
+    tolerance: float | None = None
+
+    @classmethod
+    def compare(cls, name, unit, simulated, measured, tolerance=None, relative=True) -> Check:
+        difference = simulated - measured
+        return cls(name, unit, simulated, measured, difference / abs(measured) if relative else difference, relative, tolerance)
+
+    @property
+    def passed(self) -> bool | None:
+        return None if self.tolerance is None else bool(abs(self.error) <= self.tolerance)
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "passed": self.passed}
+
+
+BURN_WINDOW_S = (0.1, 3.1)
+"""Where the axial specific force is compared [s from ignition]: the burn without the first sample
+(the liftoff transient) and the tail-off."""
+
+
+def relative_rms(simulated_t, simulated, measured_t, measured, window) -> tuple[float, float, float]:
+    """(RMS of the simulated, RMS of the measured, RMS of their difference / RMS of the measured)
+    over ``window`` [s], on the measured samples."""
+    inside = (measured_t >= window[0]) & (measured_t <= window[1])
+    reference = measured[inside]
+    model = np.interp(measured_t[inside], simulated_t, simulated)
+    rms = lambda x: float(np.sqrt(np.mean(x**2)))  # noqa: E731
+    return rms(model), rms(reference), rms(model - reference) / rms(reference)
+
+
+def simulated_descent_rate(flight: pd.DataFrame, window) -> float:
+    """Mean descent rate [m/s] of the simulated flight over ``window`` [s]."""
+    inside = flight[(flight.t_s >= window[0]) & (flight.t_s <= window[1])]
+    return float(-inside.vertical_speed_mps.mean())
+
+
+def validate_roccaraso(campaign: Campaign, reduction: FlightReduction) -> tuple[list[Check], pd.DataFrame]:
+    """The campaign's nominal flight against the Roccaraso 2021 log: the checks (tolerances of
+    issue 5 where it sets them) and the simulated flight."""
+    r = reduction
+    flight, times, _ = simulated_flight(campaign, r.landing_time_s + 20.0)
+    measured_force = r.axial_specific_force
+    sim_rms, log_rms, force_error = relative_rms(
+        flight.t_s.to_numpy(), flight.axial_specific_force_mps2.to_numpy(),
+        measured_force.t_s.to_numpy(), measured_force.specific_force_mps2.to_numpy(), BURN_WINDOW_S,
+    )  # fmt: skip
+    boost = flight[flight.t_s <= times["apogee_time_s"]]
+    return [
+        Check.compare("apogee", "m", times["apogee_agl_m"], r.apogee_agl_m, 0.03),
+        Check.compare("apogee time", "s", times["apogee_time_s"], r.apogee_time_s, 0.7, relative=False),
+        Check.compare("burnout time", "s", times["burnout_time_s"], r.burnout_time_s, relative=False),
+        Check("axial specific force, burn RMS", "m/s²", sim_rms, log_rms, force_error, True, 0.10),
+        Check.compare("max axial specific force", "m/s²", boost.axial_specific_force_mps2.max(), r.max_axial_specific_force_mps2),
+        Check.compare("max airspeed", "m/s", boost.airspeed_mps.max(), r.max_airspeed_mps),
+        Check.compare("descent rate under the drogue", "m/s", simulated_descent_rate(flight, r.drogue_window_s),
+                      r.drogue_descent_rate_mps, 0.10),  # fmt: skip
+        Check.compare("descent rate under the main", "m/s", simulated_descent_rate(flight, r.main_window_s),
+                      r.main_descent_rate_mps, 0.10),  # fmt: skip
+        Check.compare("landing point north", "m", times["impact_north_m"], r.landing_north_m, relative=False),
+        Check.compare("landing point east", "m", times["impact_east_m"], r.landing_east_m, relative=False),
+    ], flight
+
+
+EUROC_2021_APOGEE_M = 3076.0
+"""The measured apogee of Lynx at EuRoC 2021 [m above the pad] (LYNX.md; no time series is public)."""
+
+
+def validate_euroc(campaign: Campaign) -> list[Check]:
+    """The campaign's nominal apogee against the measured 3076 m (3 %)."""
+    _, times, _ = simulated_flight(campaign, 60.0)
+    return [Check.compare("apogee", "m", times["apogee_agl_m"], EUROC_2021_APOGEE_M, 0.03)]
+
+
+def plot_against_log(flight: pd.DataFrame, reduction: FlightReduction, path) -> None:
+    """Altitude, vertical speed, axial specific force and airspeed against time, simulated over
+    measured, to a PNG at ``path``."""
+    r = reduction
+    fig = Figure(figsize=(12, 8), layout="constrained")
+    panels = [  # label, measured t and values, simulated values, time span, value span (None: all)
+        ("altitude above the pad [m]", r.altitude.t_s, r.altitude.altitude_agl_m, flight.altitude_agl_m,
+         None, None),
+        ("vertical speed [m/s]", r.altitude.t_s, r.altitude.vertical_speed_mps, flight.vertical_speed_mps,
+         None, (-60.0, 220.0)),
+        ("axial specific force [m/s²]", r.axial_specific_force.t_s, r.axial_specific_force.specific_force_mps2,
+         flight.axial_specific_force_mps2, (0.0, 25.0), (-25.0, 100.0)),
+        ("airspeed [m/s]", r.airspeed.t_s, r.airspeed.airspeed_mps, flight.airspeed_mps, (0.0, 25.0), None),
+    ]  # fmt: skip
+    for ax, (label, t_log, log_values, sim_values, xlim, ylim) in zip(fig.subplots(2, 2).ravel(), panels):
+        ax.plot(t_log, log_values, color="0.4", linewidth=1.0, label="measured (Roccaraso 2021)")
+        ax.plot(flight.t_s, sim_values, color="tab:red", linewidth=1.4, label="rocketmc, nominal")
+        ax.set_xlabel("time from liftoff [s]")
+        ax.set_ylabel(label)
+        if xlim is not None:
+            ax.set_xlim(*xlim)
+        if ylim is not None:
+            ax.set_ylim(*ylim)
+        ax.grid(True, alpha=0.4)
+        ax.legend(loc="best", fontsize="small")
+    for event in (r.burnout_time_s, r.apogee_time_s, r.drogue_time_s, r.main_time_s):
+        fig.axes[0].axvline(event, color="0.7", linewidth=0.8, linestyle=":")
+    fig.suptitle("Lynx, Roccaraso 18 Sept 2021: simulated against measured (the baro is distorted in the boost "
+                 "and at the drogue's ejection; the rocket landed 95 m above the pad)")  # fmt: skip
+    fig.savefig(path, dpi=130)
