@@ -52,10 +52,11 @@ def test_preset_and_override():
         (edited("severity = 1.0", "severity = 4.0"), "environment.turbulence.severity", "less than or equal to 3"),
         (edited("values = [0.0, 1.0, 2.0, 3.0]", "values = [0.0, 1.0, 2.0, 5.0]"), "dispersions.environment.turbulence.severity", "out of range"),
         (edited("[environment.turbulence]", '[environment.wind]\nexponent = 0.2\n\n[environment.turbulence]'), "environment.wind", "'exponent' does not apply to the 'layers' wind model"),
+        (edited('preset = "lynx"', 'preset = "lynx"\nairbrakes = { time_s = [0.0, 4.0], delta_ca = [0.0, 0.5, 0.2] }'), "rocket.airbrakes", "same length"),
     ],
     ids=["missing", "wrong-type", "unknown-key", "negative-mass", "elevation>90", "negative-wind", "preset",
          "thrust-file", "isp", "dispersion-path", "dispersion-range", "dispersion-params", "dispersion-kind", "toml",
-         "severity", "severity-draw", "wind-key"],
+         "severity", "severity-draw", "wind-key", "airbrakes"],
 )  # fmt: skip
 def test_bad_input_names_the_field(text, field, words):
     with pytest.raises(ConfigError) as info:

@@ -483,3 +483,21 @@ def test_turbulence_changes_the_flight_and_is_reproducible(fly_fn, lynx_params, 
     for summary in (windy_flight[2], other):
         shift = np.hypot(summary["impact_north_m"] - turbulent["impact_north_m"], summary["impact_east_m"] - turbulent["impact_east_m"])
         assert shift > 1.0  # light gusts move the landing point by metres to hundreds of metres
+
+
+def test_airbrakes_add_their_axial_force(lynx_params):
+    """The ΔCA schedule (time since ignition) adds ΔCA·q̄·S along −x: the body-x acceleration
+    changes by exactly that over the mass, at a time in the middle of a ramp."""
+    p = still(lynx_params)
+    ev = dataclasses.replace(initial_state(p).events, rail_exit_time=jnp.asarray(0.8))
+    body = RigidBodyState(Vec3(0.0, 0.0, -900.0), Vec3(5.0, 0.0, -150.0), p.launch.q_nb0, Vec3(0.0, 0.0, 0.0))
+    braked = dataclasses.replace(p, rocket=dataclasses.replace(
+        p.rocket, airbrake_time_s=jnp.array([0.0, 4.0, 6.0]), airbrake_delta_ca=jnp.array([0.0, 0.0, 0.6])))  # fmt: skip
+    t = jnp.asarray(5.5)  # 5.0 s after ignition: halfway up the ramp, ΔCA = 0.3
+    neutral = jnp.zeros(p.rocket.aero.n_canards)
+    (d0, diag), (d1, _) = (derivatives(t, body, q, neutral, Vec3.zeros(), ev) for q in (p, braked))
+    delta_b = p.launch.q_nb0.rotate_inverse(d1.v_n - d0.v_n)
+    mass = float(mass_properties(p, 5.5).mass)
+    expected = -0.3 * float(diag.qbar) * float(p.rocket.aero.reference_area_m2) / mass
+    assert float(delta_b.x) == pytest.approx(expected, rel=1e-12)  # the same state: only ΔCA differs
+    assert abs(float(delta_b.y)) < 1e-12 and abs(float(delta_b.z)) < 1e-12

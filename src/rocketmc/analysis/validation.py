@@ -171,6 +171,6 @@ def plot_against_log(flight: pd.DataFrame, reduction: FlightReduction, path) -> 
         ax.legend(loc="best", fontsize="small")
     for event in (r.burnout_time_s, r.apogee_time_s, r.drogue_time_s, r.main_time_s):
         fig.axes[0].axvline(event, color="0.7", linewidth=0.8, linestyle=":")
-    fig.suptitle("Lynx, Roccaraso 18 Sept 2021: simulated against measured (the baro is distorted in the boost "
-                 "and at the drogue's ejection; the rocket landed 95 m above the pad)")  # fmt: skip
+    fig.suptitle("Lynx, Roccaraso 18 Sept 2021: simulated against measured\n(the baro is distorted in the boost "
+                 "and at the drogue's ejection; the rocket landed 92 m above the pad)")  # fmt: skip
     fig.savefig(path, dpi=130)
