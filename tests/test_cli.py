@@ -43,6 +43,16 @@ def test_report_json_and_plot(small_run, tmp_path, capsys):
     assert png.stat().st_size > 10_000
 
 
+def test_report_maps(small_run, tmp_path, capsys):
+    kml, geojson = tmp_path / "impacts.kml", tmp_path / "impacts.geojson"
+    assert main(["report", str(small_run), "--map", str(kml), "--map", str(geojson)]) == 0
+    assert "<kml" in kml.read_text() and json.loads(geojson.read_text())["type"] == "FeatureCollection"
+    capsys.readouterr()
+    assert main(["report", str(small_run), "--map", str(tmp_path / "impacts.txt")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith("rocketmc: error:") and ".kml or .geojson" in err
+
+
 @pytest.mark.parametrize(
     ("old", "new", "field"),
     [

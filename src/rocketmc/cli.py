@@ -48,10 +48,15 @@ def _run(args) -> int:
 
 def _report(args) -> int:
     from .analysis import format_summary, load_run, plot_impacts, summarize
+    from .analysis.export import MAP_SUFFIXES, write_map
 
     if not Path(args.file).is_file():
         print(f"rocketmc: error: {args.file}: file not found", file=sys.stderr)
         return 2
+    for path in args.map or []:
+        if Path(path).suffix.lower() not in MAP_SUFFIXES:
+            print(f"rocketmc: error: --map {path}: expected a .kml or .geojson file name", file=sys.stderr)
+            return 2
     try:
         run = load_run(args.file)
     except (OSError, ValueError) as e:
@@ -62,6 +67,12 @@ def _report(args) -> int:
     if args.plot:
         plot_impacts(run, path=args.plot)
         print(f"wrote {args.plot}", file=sys.stderr)
+    for path in args.map or []:
+        try:
+            print(f"wrote {write_map(run, path)}", file=sys.stderr)
+        except ValueError as e:
+            print(f"rocketmc: error: {e}", file=sys.stderr)
+            return 2
     return 0
 
 
@@ -191,6 +202,9 @@ def main(argv: list[str] | None = None) -> int:
     report.add_argument("file", help="HDF5 result file")
     report.add_argument("--plot", help="write the impact plot with 50/95/99 %% ellipses to this PNG")
     report.add_argument("--json", action="store_true", help="print the summary as JSON")
+    report.add_argument("--map", action="append", metavar="FILE",
+                        help="write the impact points and ellipses around the launch site as KML (.kml) or "
+                             "GeoJSON (.geojson); repeatable")  # fmt: skip
     aero = commands.add_parser("aero", help="aerodynamic coefficients of a rocket")
     aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
     derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")

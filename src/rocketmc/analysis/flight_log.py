@@ -20,6 +20,7 @@ import pandas as pd
 from scipy.signal import savgol_filter
 
 from ..env.atmosphere import troposphere_altitude
+from ..env.site import north_east_m
 
 ROCCARASO_2021 = resources.files("rocketmc") / "data" / "flights" / "roccaraso_2021"
 
@@ -59,7 +60,6 @@ WIND_BIN_M = 100.0
 """Altitude bin [m] of the wind profile: 4 s of GNSS under the drogue, ~18 s under the main."""
 WIND_MIN_SAMPLES = 25
 """Bins with fewer GNSS samples (1 s) are left out of the wind profile."""
-_WGS84_A, _WGS84_E2 = 6378137.0, 6.69437999014e-3  # WGS84 semi-major axis [m], eccentricity²
 
 
 @dataclass(frozen=True)
@@ -201,15 +201,6 @@ def _apogee(t: np.ndarray, altitude: np.ndarray, before: float) -> tuple[float, 
     return float(t_top), float(c - b * b / (4.0 * a))
 
 
-def _north_east_m(latitude_deg, longitude_deg, site: Site) -> tuple[float, float]:
-    """North, east [m] of a position from the site on the flat local tangent plane (WGS84 curvature radii)."""
-    phi = np.radians(site.latitude_deg)
-    w = 1.0 - _WGS84_E2 * np.sin(phi) ** 2
-    north = np.radians(latitude_deg - site.latitude_deg) * _WGS84_A * (1.0 - _WGS84_E2) / w**1.5
-    east = np.radians(longitude_deg - site.longitude_deg) * _WGS84_A / np.sqrt(w) * np.cos(phi)
-    return float(north), float(east)
-
-
 def _wind_profile(gnss: pd.DataFrame, altitude: pd.DataFrame, windows) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(altitude_agl_m, speed_mps, from_deg): the mean GNSS horizontal velocity per altitude bin within
     the time ``windows``; the altitude of a bin is the mean of its samples'."""
@@ -256,9 +247,10 @@ def reduce_flight(log: FlightLog) -> FlightReduction:
 
     t_pitot = log.pitot["t_s"].to_numpy()
     k_air = int(np.argmax(np.where(t_pitot < drogue, log.pitot["airspeed_mps"], -np.inf)))
-    landing_north, landing_east = _north_east_m(
-        *(np.interp(landing, log.gnss["t_s"], log.gnss[c]) for c in ("latitude_deg", "longitude_deg")), log.site
-    )
+    landing_north, landing_east = (float(x) for x in north_east_m(
+        *(np.interp(landing, log.gnss["t_s"], log.gnss[c]) for c in ("latitude_deg", "longitude_deg")),
+        log.site.latitude_deg, log.site.longitude_deg,
+    ))  # fmt: skip
     return FlightReduction(
         altitude=altitude,
         axial_specific_force=pd.DataFrame({"t_s": t_imu, "specific_force_mps2": axial}),

@@ -1,0 +1,92 @@
+"""Impact maps: the local tangent plane against the sphere, GeoJSON (RFC 7946) and KML 2.2 structure,
+and the ellipses' outlines back on the plane."""
+
+from __future__ import annotations
+
+import json
+from xml.etree import ElementTree
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rocketmc.analysis import Run, confidence_ellipse
+from rocketmc.analysis.export import KML_NAMESPACE, to_geojson, to_kml, write_map
+from rocketmc.env.site import latitude_longitude_deg, north_east_m
+
+SITE = (41.8087, 14.0543)  # Roccaraso
+
+
+@pytest.fixture(scope="module")
+def run():
+    rng = np.random.default_rng(3)
+    north, east = rng.normal(-300.0, 600.0, 500), rng.normal(400.0, 350.0, 500)
+    east += 0.4 * north  # a tilted footprint
+    status = np.zeros(500, dtype=np.int32)
+    status[:7] = 2
+    outputs = pd.DataFrame({"impact_north_m": north, "impact_east_m": east, "status": status})
+    toml = f'name = "map"\n[site]\nname = "Roccaraso"\nlatitude_deg = {SITE[0]}\nlongitude_deg = {SITE[1]}\naltitude_m = 1416.0\n'
+    return Run(outputs, pd.DataFrame(), {"campaign_name": "map", "campaign_toml": toml}, {}, {})
+
+
+def test_local_plane_round_trip_and_against_the_sphere():
+    north, east = np.array([-4000.0, 0.0, 2500.0]), np.array([3000.0, -5000.0, 0.0])
+    lat, lon = latitude_longitude_deg(north, east, *SITE)
+    back = north_east_m(lat, lon, *SITE)
+    np.testing.assert_allclose(back, (north, east), atol=1e-9)  # exact inverses: rounding only
+    # Haversine on a sphere of 6371 km: the ellipsoid's radii differ from it by < 0.5 % at 42°N.
+    phi1, phi2, dlon = np.radians(SITE[0]), np.radians(lat), np.radians(lon - SITE[1])
+    h = np.sin((phi2 - phi1) / 2) ** 2 + np.cos(phi1) * np.cos(phi2) * np.sin(dlon / 2) ** 2
+    np.testing.assert_allclose(2 * 6371e3 * np.arcsin(np.sqrt(h)), np.hypot(north, east), rtol=5e-3)
+
+
+def test_geojson_is_valid_and_ellipses_lie_on_the_ellipse(run):
+    data = json.loads(json.dumps(to_geojson(run)))  # plain JSON types only
+    assert data["type"] == "FeatureCollection"
+    kinds = [f["geometry"]["type"] for f in data["features"]]
+    assert kinds == ["Point", "MultiPoint", "Polygon", "Polygon", "Polygon"]
+    assert data["features"][0]["geometry"]["coordinates"] == [SITE[1], SITE[0]]  # [longitude, latitude]
+    assert len(data["features"][1]["geometry"]["coordinates"]) == 493  # the ok impacts
+    north, east = run.ok_impacts()
+    for feature in data["features"][2:]:
+        assert feature["type"] == "Feature" and "properties" in feature
+        (ring,) = feature["geometry"]["coordinates"]
+        assert len(ring) >= 4 and ring[0] == ring[-1]  # RFC 7946 §3.1.6: closed linear ring
+        x, y = np.asarray(ring[:-1]).T
+        assert 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0  # exterior ring counterclockwise
+        assert np.all(np.abs(x) <= 180) and np.all(np.abs(y) <= 90)
+        ellipse = confidence_ellipse(north, east, feature["properties"]["level"])
+        ring_north, ring_east = north_east_m(y, x, *SITE)
+        # back on the plane, every vertex is on the ellipse: normalised radius 1 (1e-9: rounding)
+        a, b = ellipse._axes()
+        dn, de = ring_north - ellipse.center_north_m, ring_east - ellipse.center_east_m
+        radius2 = ((dn * a[0] + de * a[1]) / ellipse.semi_major_m) ** 2 + ((dn * b[0] + de * b[1]) / ellipse.semi_minor_m) ** 2
+        np.testing.assert_allclose(radius2, 1.0, atol=1e-9)
+
+
+def test_kml_parses_and_follows_the_schema_order(run):
+    root = ElementTree.fromstring(to_kml(run).encode())
+    ns = {"k": KML_NAMESPACE}
+    assert root.tag == f"{{{KML_NAMESPACE}}}kml"
+    document = root.find("k:Document", ns)
+    tags = [child.tag.split("}")[1] for child in document]
+    assert tags[0] == "name" and tags.index("Placemark") > max(i for i, t in enumerate(tags) if t == "Style")
+    rings = document.findall("k:Placemark/k:Polygon/k:outerBoundaryIs/k:LinearRing/k:coordinates", ns)
+    assert len(rings) == 3
+    for ring in rings:
+        points = [tuple(map(float, p.split(","))) for p in ring.text.split()]
+        assert points[0] == points[-1] and all(len(p) == 3 for p in points)
+    assert len(document.findall("k:Folder/k:Placemark/k:Point", ns)) == 493
+    for mark in document.iter(f"{{{KML_NAMESPACE}}}Placemark"):
+        children = [c.tag.split("}")[1] for c in mark]
+        assert children[0] == "name" and children[-1] in ("Point", "Polygon")  # styleUrl before the geometry
+
+
+def test_write_map_by_suffix_and_errors(run, tmp_path):
+    assert write_map(run, tmp_path / "m.geojson").read_text().startswith("{")
+    assert write_map(run, tmp_path / "m.kml").read_text().startswith("<?xml")
+    with pytest.raises(ValueError, match="expected a .kml or .geojson"):
+        write_map(run, tmp_path / "m.txt")
+    no_site = Run(run.outputs, run.inputs, {"campaign_toml": 'name = "x"\n'}, {}, {})
+    with pytest.raises(ValueError, match=r"no \[site\]"):
+        to_geojson(no_site)
