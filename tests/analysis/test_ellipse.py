@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from rocketmc.analysis import Ellipse, chi2_scale, confidence_ellipse
+from rocketmc.analysis.ellipse import bootstrap_intervals, ellipse_area_m2
 
 N_BIG = 200_000
 # True impact distribution (north, east) [m]: std 250 m along azimuth 30 deg, 80 m across.
@@ -161,3 +162,24 @@ def test_to_dict_fields():
     }
     assert d["area_m2"] == e.area_m2 and d["level"] == 0.5
     assert isinstance(e, Ellipse)
+
+
+def test_bootstrap_area_formula_and_interval_coverage():
+    """The vectorised area equals the ellipse's; the 95 % percentile-bootstrap interval of the area and
+    centre holds the true values (π·k²·sqrt(det Σ), the mean) in 95 % of 200 independent samples of
+    N = 300 correlated normal points: within 4 binomial standard errors (1.5 % each) of 95 %."""
+    rng = np.random.default_rng(11)
+    cov = np.array([[500.0**2, 0.6 * 500 * 300], [0.6 * 500 * 300, 300.0**2]])
+    true_area = np.pi * chi2_scale(0.95) * np.sqrt(np.linalg.det(cov))
+    points = rng.multivariate_normal([100.0, -50.0], cov, size=(200, 300))
+    assert ellipse_area_m2(points[0, :, 0], points[0, :, 1]) == pytest.approx(
+        confidence_ellipse(points[0, :, 0], points[0, :, 1]).area_m2, rel=1e-12
+    )
+    hits = {"area_m2": 0, "center_north_m": 0, "center_east_m": 0}
+    truth = {"area_m2": true_area, "center_north_m": 100.0, "center_east_m": -50.0}
+    for sample in points:
+        intervals = bootstrap_intervals(sample[:, 0], sample[:, 1], n_resamples=1000, seed=1)
+        for name, (low, high) in intervals.items():
+            hits[name] += low <= truth[name] <= high
+    for name, count in hits.items():
+        assert abs(count / 200 - 0.95) < 4 * np.sqrt(0.95 * 0.05 / 200), (name, count)

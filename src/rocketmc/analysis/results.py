@@ -18,7 +18,7 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from .ellipse import confidence_ellipse
+from .ellipse import bootstrap_intervals, confidence_ellipse
 
 SUMMARY_LEVELS = (0.5, 0.95, 0.99)
 """Confidence levels of the impact ellipses in :func:`summarize`."""
@@ -153,7 +153,9 @@ def summarize(run: Run) -> dict:
     ``status`` (list of code/message/count, every known code and any other code seen),
     ``metrics`` (per output except status, over ok realizations and finite values: unit, n,
     mean, std (ddof=1), min, p5, p50, p95, max) and ``impact_ellipses`` (``Ellipse.to_dict()``
-    at 50/95/99 % of the ok impact points; empty when fewer than 3 are available).
+    at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
+    ``impact_ellipse_95_intervals`` (``bootstrap_intervals`` of the 95 % ellipse's area and centre;
+    None below 10 points).
     """
     ok = run.ok
     status = run.outputs["status"].to_numpy()
@@ -179,6 +181,7 @@ def summarize(run: Run) -> dict:
         if north.size >= 3
         else []
     )
+    intervals = bootstrap_intervals(north, east, 0.95) if north.size >= 10 else None
     return {
         "campaign_name": run.attrs.get("campaign_name", ""),
         "seed": run.attrs.get("seed"),
@@ -188,6 +191,7 @@ def summarize(run: Run) -> dict:
         "status": status_rows,
         "metrics": metrics,
         "impact_ellipses": ellipses,
+        "impact_ellipse_95_intervals": intervals,
     }
 
 
@@ -262,6 +266,11 @@ def format_summary(summary: dict) -> str:
             align="r" * 8,
         )
         out.append("  (N, E: centre; a, b: semi-axes; az: major axis, clockwise from north)")
+    if summary["impact_ellipse_95_intervals"]:
+        i = summary["impact_ellipse_95_intervals"]
+        out.append(f"  95 % ellipse, 95 % bootstrap intervals: area {i['area_m2'][0] / 1e6:.4g}–{i['area_m2'][1] / 1e6:.4g} "
+                   f"km², centre N {i['center_north_m'][0]:.1f}…{i['center_north_m'][1]:.1f} m, "
+                   f"E {i['center_east_m'][0]:.1f}…{i['center_east_m'][1]:.1f} m")  # fmt: skip
     else:
         out.append("  not available: fewer than 3 ok impact points")
     return "\n".join(out)
