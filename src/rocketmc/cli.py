@@ -15,7 +15,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _run(args) -> int:
-    from .campaign import ConfigError, ResultWriter, load_campaign, run_chunks
+    from .campaign import ConfigError, ResultWriter, ResumeError, load_campaign, run_chunks
 
     try:
         campaign = load_campaign(args.campaign).with_overrides(
@@ -28,21 +28,34 @@ def _run(args) -> int:
     out = Path(args.out or f"{cfg.name}.h5")
     chunk_size = min(args.chunk_size or cfg.simulation.chunk_size, cfg.n_realizations)
     n_chunks = -(-cfg.n_realizations // chunk_size)
+    try:
+        writer = ResultWriter(out, campaign, chunk_size, resume=args.resume)
+    except ResumeError as e:
+        print(f"rocketmc: error: {e}", file=sys.stderr)
+        return 2
+    done = set(writer.completed_chunks())
+    todo = [c for c in range(n_chunks) if c not in done]
     log = lambda msg: print(msg, file=sys.stderr, flush=True)  # noqa: E731
-    log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}")
-    runs = run_chunks(campaign, chunk_size)
-    log(f"compiled in {next(runs):.1f} s")
+    log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
+        + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
     flown, seconds = 0, 0.0
-    with ResultWriter(out, campaign, chunk_size) as writer:
-        for i, chunk in enumerate(runs):
-            writer.write(chunk, i)
+    if todo:
+        runs = run_chunks(campaign, chunk_size, chunks=todo)
+        log(f"compiled in {next(runs):.1f} s")
+        for i, (index, chunk) in enumerate(zip(todo, runs)):
+            writer.write(chunk, index)
             n = len(chunk.outputs["status"])
             flown, seconds = flown + n, seconds + chunk.seconds
             failed = int((chunk.outputs["status"] != 0).sum())
-            log(f"chunk {i + 1}/{n_chunks}: {n} flights in {chunk.seconds:.1f} s "
+            log(f"chunk {index + 1}/{n_chunks} ({i + 1} of {len(todo)} this run): {n} flights in {chunk.seconds:.1f} s "
                 f"({n / chunk.seconds:.0f} flights/s){f', {failed} not ok' if failed else ''}")  # fmt: skip
+    try:
         writer.finish()
-    log(f"wrote {out} ({flown} flights, {flown / seconds:.0f} flights/s after compilation)")
+    except ResumeError as e:
+        print(f"rocketmc: error: {e}", file=sys.stderr)
+        return 2
+    rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
+    log(f"wrote {out} ({flown} flights flown in this run{rate})")
     return 0
 
 
@@ -196,6 +209,8 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
     run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
+    run.add_argument("--resume", action="store_true",
+                     help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
     run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                      help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
     report = commands.add_parser("report", help="summarize a result file: ellipses and statistics")

@@ -14,9 +14,7 @@ Every reading error is an ``AeroFileError`` whose one-line message starts with t
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
 from pathlib import Path
 
 import h5py
@@ -24,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from ..files import replacing
 from .datcom import DATCOM_COEFFS, LYNX_DATCOM, DatcomFileError, load_datcom_mat
 from .tables import AXIS_UNITS, BODY_COEFFS, AeroTables, CanardPanels, GriddedCoefficients
 
@@ -55,18 +54,6 @@ def _existing(path) -> Path:
     if not path.is_file():
         raise AeroFileError(f"{path}: file not found")
     return path
-
-
-@contextlib.contextmanager
-def _replacing(path):
-    """Yields a temporary path next to ``path`` to write; moves it onto ``path`` only on success."""
-    path = Path(path)
-    partial = path.with_name(path.name + ".partial")
-    try:
-        yield partial
-        os.replace(partial, path)
-    finally:
-        partial.unlink(missing_ok=True)
 
 
 # --- Missile DATCOM ------------------------------------------------------------------------------
@@ -129,7 +116,7 @@ def _write_table(group: h5py.Group, table: GriddedCoefficients) -> None:
 
 def save_aero_tables(path, tables: AeroTables) -> None:
     """Writes ``tables`` to the HDF5 file ``path`` (replaced atomically: written aside, then moved)."""
-    with _replacing(path) as partial, h5py.File(partial, "w") as file:
+    with replacing(path) as partial, h5py.File(partial, "w") as file:
         file.attrs["format"] = FORMAT
         file.attrs["format_version"] = FORMAT_VERSION
         for key in REFERENCE_KEYS:
@@ -348,7 +335,7 @@ def write_aero_csv(path, tables: AeroTables) -> None:
         for name, x in zip(body.axis_names, points)
     }
     columns.update(zip(BODY_COEFFS, body.values.reshape(-1, len(BODY_COEFFS)).T))
-    with _replacing(path) as partial, open(partial, "w", encoding="utf-8", newline="") as file:
+    with replacing(path) as partial, open(partial, "w", encoding="utf-8", newline="") as file:
         file.write(f"# rocketmc aerodynamic table, written by rocketmc {__version__}\n")
         file.writelines(f"# {key} = {float(getattr(tables, key))!r}\n" for key in REFERENCE_KEYS)
         if tables.source:

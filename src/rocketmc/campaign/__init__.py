@@ -9,3 +9,4 @@ from .model import flight_params as flight_params
 from .model import nominal_params as nominal_params
 from .runner import run_chunks as run_chunks
 from .store import ResultWriter as ResultWriter
+from .store import ResumeError as ResumeError

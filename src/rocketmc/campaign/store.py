@@ -1,51 +1,110 @@
-"""HDF5 result files (the output contract of docs/architecture.md).
+"""HDF5 result files (the output contract of docs/conventions.md), written so that a killed run loses
+at most the chunks in flight.
 
-A run writes ``<out>.partial`` chunk by chunk, with ``complete = False`` and the list of finished
-chunks in the root attributes; only when every chunk is in does it set ``complete = True`` and
-rename the file to ``<out>``. A file that looks complete therefore is.
+A run keeps its finished chunks in the folder ``<out>.partial/``: ``manifest.json`` (what the run is:
+campaign text, seed, N, chunk size) and one ``chunk_<k>.h5`` per finished chunk, each written under a
+temporary name, flushed to disk and renamed, so a chunk file that exists is whole. ``finish()`` streams
+the chunk files, one at a time, into ``<out>`` (written the same way) and removes the folder: a file at
+``<out>`` is complete. ``ResultWriter(..., resume=True)`` reopens the folder of a killed run, refuses
+one that belongs to another campaign, and reports which chunks are done.
 """
 
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from .. import __version__
+from ..files import replacing
 from ..sim.flight import Status, unit_of
 from .config import Campaign
 from .runner import ChunkResult
 
 
-def partial_path(out: Path) -> Path:
+class ResumeError(ValueError):
+    """A partial run that cannot be resumed (another campaign's, or damaged); one line."""
+
+
+def partial_dir(out: Path) -> Path:
     return out.with_name(out.name + ".partial")
 
 
 class ResultWriter:
-    """Writes one campaign's results; use as a context manager, ``write(chunk)``, then ``finish()``."""
+    """Writes one campaign's results: ``write(chunk, index)`` per finished chunk, then ``finish()``."""
 
-    def __init__(self, out: str | Path, campaign: Campaign, chunk_size: int):
+    def __init__(self, out: str | Path, campaign: Campaign, chunk_size: int, resume: bool = False):
         self.out = Path(out)
-        self.path = partial_path(self.out)
-        self.n = campaign.config.n_realizations
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.file = h5py.File(self.path, "w")
-        attrs = self.file.attrs
-        attrs["campaign_name"] = campaign.config.name
-        attrs["campaign_toml"] = campaign.text
-        attrs["rocketmc_version"] = __version__
-        attrs["seed"] = campaign.config.seed
-        attrs["n_realizations"] = self.n
-        attrs["chunk_size"] = chunk_size
-        attrs["completed_chunks"] = np.zeros(0, dtype=np.int64)
-        attrs["complete"] = False
-        self.file.create_group("outputs")
-        self.file.create_group("inputs")
+        self.dir = partial_dir(self.out)
+        cfg = campaign.config
+        self.n = cfg.n_realizations
+        self.manifest = {"campaign_name": cfg.name, "campaign_toml": campaign.text, "seed": cfg.seed,
+                         "n_realizations": self.n, "chunk_size": chunk_size}  # fmt: skip
+        manifest_path = self.dir / "manifest.json"
+        if resume:
+            try:
+                found = json.loads(manifest_path.read_text())
+            except (OSError, ValueError):
+                raise ResumeError(f"{self.dir}: no readable manifest.json, not a rocketmc partial run") from None
+            differing = [k for k, v in self.manifest.items() if found.get(k) != v]
+            if differing:
+                raise ResumeError(f"{self.dir}: a partial run of another campaign or set-up ({', '.join(differing)} "
+                                  "differ); not resumed, nothing overwritten")  # fmt: skip
+        else:
+            if self.dir.exists():
+                raise ResumeError(f"{self.dir}: a partial run is there already; resume it with --resume or delete it")
+            self.dir.mkdir(parents=True)
+            with replacing(manifest_path) as path:
+                path.write_text(json.dumps(self.manifest, indent=1))
 
-    def _dataset(self, group: str, name: str, like: np.ndarray):
-        g = self.file[group]
+    def _chunk_path(self, index: int) -> Path:
+        return self.dir / f"chunk_{index:06d}.h5"
+
+    def completed_chunks(self) -> list[int]:
+        """Indices of the chunks already written."""
+        return sorted(int(p.stem.removeprefix("chunk_")) for p in self.dir.glob("chunk_*.h5"))
+
+    def write(self, chunk: ChunkResult, chunk_index: int) -> None:
+        """Commit one chunk: written whole or not at all."""
+        with replacing(self._chunk_path(chunk_index)) as path, h5py.File(path, "w") as f:
+            f.attrs["start"] = chunk.start
+            for group, data in (("outputs", chunk.outputs), ("inputs", chunk.inputs)):
+                g = f.create_group(group)
+                for name, values in data.items():
+                    g.create_dataset(name, data=values)
+
+    def finish(self) -> Path:
+        """Gather the chunks into ``<out>`` (complete) and remove the partial folder."""
+        done = self.completed_chunks()
+        with replacing(self.out) as path, h5py.File(path, "w") as f:
+            f.attrs.update({k: v for k, v in self.manifest.items()})
+            f.attrs["rocketmc_version"] = __version__
+            f.attrs["completed_chunks"] = np.asarray(done, dtype=np.int64)
+            f.create_group("outputs")
+            f.create_group("inputs")
+            rows = 0
+            for index in done:
+                try:
+                    with h5py.File(self._chunk_path(index), "r") as chunk:
+                        start = int(chunk.attrs["start"])
+                        for group in ("outputs", "inputs"):
+                            for name, ds in chunk[group].items():
+                                values = ds[()]
+                                self._dataset(f, group, name, values)[start : start + len(values)] = values
+                        rows += len(chunk["outputs/status"])
+                except (OSError, KeyError) as e:
+                    raise ResumeError(f"{self._chunk_path(index)}: unreadable chunk ({e}); delete it and resume") from None
+            if rows != self.n:
+                raise ResumeError(f"{self.dir}: the chunks hold {rows} of {self.n} realizations")
+            f.attrs["complete"] = True
+        shutil.rmtree(self.dir)
+        return self.out
+
+    def _dataset(self, f: h5py.File, group: str, name: str, like: np.ndarray):
+        g = f.require_group(group)
         if name not in g:
             fill = 0 if np.issubdtype(like.dtype, np.integer) else np.nan
             ds = g.create_dataset(name, shape=(self.n,), dtype=like.dtype, fillvalue=fill)
@@ -55,25 +114,3 @@ class ResultWriter:
             elif group == "outputs":
                 ds.attrs["unit"] = unit_of(name)
         return g[name]
-
-    def write(self, chunk: ChunkResult, chunk_index: int) -> None:
-        rows = slice(chunk.start, chunk.start + len(chunk.outputs["status"]))
-        for group, data in (("outputs", chunk.outputs), ("inputs", chunk.inputs)):
-            for name, values in data.items():
-                self._dataset(group, name, values)[rows] = values
-        done = self.file.attrs["completed_chunks"]
-        self.file.attrs["completed_chunks"] = np.append(done, chunk_index)
-        self.file.flush()
-
-    def finish(self) -> Path:
-        """Mark complete and move into place."""
-        self.file.attrs["complete"] = True
-        self.file.close()
-        self.path.replace(self.out)
-        return self.out
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.file.close()  # a no-op after finish(); leaves the .partial file on error
