@@ -35,20 +35,28 @@ def _run(args) -> int:
         return 2
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
-    log = lambda msg: print(msg, file=sys.stderr, flush=True)  # noqa: E731
+    tty = sys.stderr.isatty() and not args.quiet
+
+    def log(msg, progress=False):
+        """A line on stderr; on a terminal, progress lines overwrite each other in place."""
+        if not args.quiet:
+            print(("\r\033[K" if tty else "") + msg, end="" if progress and tty else "\n", file=sys.stderr, flush=True)
+
     log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
         + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
-    flown, seconds = 0, 0.0
+    flown, seconds, failed = 0, 0.0, 0
     if todo:
         runs = run_chunks(campaign, chunk_size, chunks=todo)
         log(f"compiled in {next(runs):.1f} s")
         for i, (index, chunk) in enumerate(zip(todo, runs)):
             writer.write(chunk, index)
-            n = len(chunk.outputs["status"])
-            flown, seconds = flown + n, seconds + chunk.seconds
-            failed = int((chunk.outputs["status"] != 0).sum())
-            log(f"chunk {index + 1}/{n_chunks} ({i + 1} of {len(todo)} this run): {n} flights in {chunk.seconds:.1f} s "
-                f"({n / chunk.seconds:.0f} flights/s){f', {failed} not ok' if failed else ''}")  # fmt: skip
+            flown, seconds = flown + len(chunk.outputs["status"]), seconds + chunk.seconds
+            failed += int((chunk.outputs["status"] != 0).sum())
+            left = (len(todo) - i - 1) * seconds / (i + 1)
+            log(f"chunk {index + 1}/{n_chunks}: {flown} flights this run, {flown / seconds:.0f} flights/s, "
+                f"ETA {left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
+        if tty:
+            print(file=sys.stderr)  # keep the last progress line
     try:
         writer.finish()
     except ResumeError as e:
@@ -209,6 +217,7 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
     run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
+    run.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     run.add_argument("--resume", action="store_true",
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
     run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),

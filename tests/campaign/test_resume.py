@@ -25,9 +25,10 @@ def contents(path):
         return {f"{g}/{k}": ds[()] for g in ("outputs", "inputs") for k, ds in f[g].items()}, dict(f.attrs)
 
 
-def test_killed_run_resumes_to_the_same_bits(tmp_path):
+def test_killed_run_resumes_to_the_same_bits(tmp_path, capsys):
     reference = tmp_path / "reference.h5"
-    assert main(["run", CAMPAIGN, *ARGS, "--out", str(reference)]) == 0
+    assert main(["run", CAMPAIGN, *ARGS, "--out", str(reference), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""  # --quiet: no progress lines
 
     out = tmp_path / "killed.h5"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
