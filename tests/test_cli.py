@@ -100,3 +100,21 @@ def test_aero_derivatives(capsys):
     assert main(["aero", "derivatives", "lynx", "--mach", "0.3"]) == 0
     text = capsys.readouterr().out
     assert f"{c['CNa']:.3f}" in text and "static margin" in text
+
+
+def test_until_converged_stops_by_itself(tmp_path, capsys):
+    """lynx_ballistic with a 25 % target: the 95 % ellipse area's bootstrap interval is that narrow after a
+    few hundred flights (its width goes as ~3.9/sqrt(N)), far below the 2000 allowed; the file keeps the
+    N reached, a whole number of chunks, and the log says so."""
+    out = tmp_path / "converged.h5"
+    args = ["run", str(CAMPAIGNS / "lynx_ballistic.toml"), "-n", "2000", "--chunk-size", "50", "--out", str(out)]
+    assert main([*args, "--until-converged", "25"]) == 0
+    log = capsys.readouterr().err
+    with h5py.File(out) as f:
+        n = int(f.attrs["n_realizations"])
+        assert f.attrs["complete"] and f["outputs/status"].shape == (n,)
+    assert 100 <= n < 2000 and n % 50 == 0
+    assert f"converged at N = {n}" in log
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--until-converged", "0"])
+    assert info.value.code == 2

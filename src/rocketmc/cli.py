@@ -15,6 +15,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _run(args) -> int:
+    from .analysis.ellipse import AreaConvergence
     from .campaign import ConfigError, ResultWriter, ResumeError, load_campaign, run_chunks
 
     try:
@@ -45,7 +46,11 @@ def _run(args) -> int:
     log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
         + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
     flown, seconds, failed = 0, 0.0, 0
-    if todo:
+    convergence = None if args.until_converged is None else AreaConvergence(args.until_converged / 100.0)
+    if convergence is not None:
+        for index in sorted(done):
+            convergence.add(writer.chunk_outputs(index, ("status", "impact_north_m", "impact_east_m")))
+    if todo and not (convergence and convergence.check()):
         runs = run_chunks(campaign, chunk_size, chunks=todo)
         log(f"compiled in {next(runs):.1f} s")
         for i, (index, chunk) in enumerate(zip(todo, runs)):
@@ -54,11 +59,21 @@ def _run(args) -> int:
             failed += int((chunk.outputs["status"] != 0).sum())
             left = (len(todo) - i - 1) * seconds / (i + 1)
             log(f"chunk {index + 1}/{n_chunks}: {flown} flights this run, {flown / seconds:.0f} flights/s, "
-                f"ETA {left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
+                f"ETA {'≤ ' if convergence else ''}{left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
+            if convergence is not None:
+                convergence.add(chunk.outputs)
+                if convergence.check():
+                    break
         if tty:
             print(file=sys.stderr)  # keep the last progress line
+    n_rows = None
+    if convergence is not None:
+        n_rows = convergence.n
+        state = "converged" if convergence.converged else f"not converged within the {cfg.n_realizations} allowed"
+        log(f"{state} at N = {n_rows}: the 95 % ellipse's area is {convergence.area_m2 / 1e6:.4g} km², its 95 % "
+            f"bootstrap interval {100 * convergence.width:.2f} % of it wide (target {args.until_converged:g} %)")  # fmt: skip
     try:
-        writer.finish()
+        writer.finish(n_rows)
     except ResumeError as e:
         print(f"rocketmc: error: {e}", file=sys.stderr)
         return 2
@@ -218,6 +233,9 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
     run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
     run.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
+    run.add_argument("--until-converged", type=float, metavar="PCT",
+                     help="add chunks (up to N) until the 95 %% ellipse area's 95 %% bootstrap interval is "
+                          "narrower than PCT %% of the area; the file keeps the N reached")  # fmt: skip
     run.add_argument("--resume", action="store_true",
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
     run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
@@ -242,6 +260,8 @@ def main(argv: list[str] | None = None) -> int:
     validate.add_argument("--plot", help="folder for the overlay plots (roccaraso-2021)")
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
     args = parser.parse_args(argv)
+    if getattr(args, "until_converged", None) is not None and not args.until_converged > 0:
+        parser.error("--until-converged must be a positive percentage")
     for name in ("n", "chunk_size"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")

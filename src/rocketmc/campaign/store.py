@@ -76,11 +76,19 @@ class ResultWriter:
                 for name, values in data.items():
                     g.create_dataset(name, data=values)
 
-    def finish(self) -> Path:
-        """Gather the chunks into ``<out>`` (complete) and remove the partial folder."""
-        done = self.completed_chunks()
+    def chunk_outputs(self, index: int, names) -> dict[str, np.ndarray]:
+        """Some ``/outputs`` of a written chunk."""
+        with h5py.File(self._chunk_path(index), "r") as chunk:
+            return {name: chunk["outputs"][name][()] for name in names}
+
+    def finish(self, n_rows: int | None = None) -> Path:
+        """Gather the chunks into ``<out>`` (complete) and remove the partial folder. ``n_rows``: the
+        realizations kept when a run stopped early (``--until-converged``), the first chunks' rows."""
+        n = self.n if n_rows is None else n_rows
+        done = [c for c in self.completed_chunks() if c * self.manifest["chunk_size"] < n]
         with replacing(self.out) as path, h5py.File(path, "w") as f:
             f.attrs.update({k: v for k, v in self.manifest.items()})
+            f.attrs["n_realizations"] = n
             f.attrs["rocketmc_version"] = __version__
             f.attrs["completed_chunks"] = np.asarray(done, dtype=np.int64)
             f.create_group("outputs")
@@ -93,21 +101,22 @@ class ResultWriter:
                         for group in ("outputs", "inputs"):
                             for name, ds in chunk[group].items():
                                 values = ds[()]
-                                self._dataset(f, group, name, values)[start : start + len(values)] = values
+                                self._dataset(f, group, name, values, n)[start : start + len(values)] = values
                         rows += len(chunk["outputs/status"])
                 except (OSError, KeyError) as e:
                     raise ResumeError(f"{self._chunk_path(index)}: unreadable chunk ({e}); delete it and resume") from None
-            if rows != self.n:
-                raise ResumeError(f"{self.dir}: the chunks hold {rows} of {self.n} realizations")
+            if rows != n:
+                raise ResumeError(f"{self.dir}: the chunks hold {rows} of {n} realizations")
             f.attrs["complete"] = True
         shutil.rmtree(self.dir)
         return self.out
 
-    def _dataset(self, f: h5py.File, group: str, name: str, like: np.ndarray):
+    @staticmethod
+    def _dataset(f: h5py.File, group: str, name: str, like: np.ndarray, n: int):
         g = f.require_group(group)
         if name not in g:
             fill = 0 if np.issubdtype(like.dtype, np.integer) else np.nan
-            ds = g.create_dataset(name, shape=(self.n,), dtype=like.dtype, fillvalue=fill)
+            ds = g.create_dataset(name, shape=(n,), dtype=like.dtype, fillvalue=fill)
             if name == "status":
                 ds.attrs["unit"] = "1"
                 ds.attrs["codes"] = json.dumps({str(int(s)): s.message for s in Status})
