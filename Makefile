@@ -20,11 +20,11 @@ demo: install
 	$(VENV)/bin/rocketmc run campaigns/lynx_nominal.toml -n $(N) --out results/lynx_nominal.h5
 	$(VENV)/bin/rocketmc report results/lynx_nominal.h5 --plot results/lynx_nominal_ellipses.png
 
-test: install
-	$(PY) -m pytest -n 2 -q
+test: install  # timing tests (-m performance) alone, after the parallel ones
+	$(PY) -m pytest -n 2 -q -m "not performance" && $(PY) -m pytest -q -m performance
 
 bench: install
-	$(PY) benchmarks/throughput.py
+	$(VENV)/bin/rocketmc bench
 
 clean:
 	rm -rf results .pytest_cache

@@ -21,8 +21,9 @@ import time
 import jax
 import numpy as np
 
+from rocketmc.bench import seconds_per_flight
 from rocketmc.campaign import load_campaign
-from rocketmc.campaign.runner import compile_chunk
+from rocketmc.campaign.runner import batch_size, compile_chunk
 
 MODELS = ("interpolated", "simplified", "linear")
 
@@ -37,23 +38,19 @@ def main() -> int:
     args = parser.parse_args()
 
     base = load_campaign(args.campaign)
-    compiled, compile_s, apogee = {}, {}, {}
+    batch = batch_size(args.n)
+    compiled, compile_s = {}, {}
     for model in MODELS:
         campaign = base.with_overrides(n_realizations=args.n, aero_model=model)
         t0 = time.perf_counter()
-        compiled[model] = compile_chunk(campaign, args.n)
+        compiled[model] = compile_chunk(campaign, batch)
         compile_s[model] = time.perf_counter() - t0
     key = jax.random.key(base.config.seed)
-    indices = np.arange(args.n, dtype=np.uint32)
-    best = {model: float("inf") for model in MODELS}
-    for _ in range(args.repeats):
-        for model in MODELS:
-            t0 = time.perf_counter()
-            summary, status, _ = jax.block_until_ready(compiled[model](key, indices))
-            best[model] = min(best[model], time.perf_counter() - t0)
-            apogee[model] = float(np.nanmean(np.asarray(summary["apogee_agl_m"])))
+    best = seconds_per_flight({model: (f, batch) for model, f in compiled.items()}, key, args.repeats)
+    indices = np.arange(batch, dtype=np.uint32)
+    apogee = {model: float(np.nanmean(np.asarray(f(key, indices)[0]["apogee_agl_m"]))) for model, f in compiled.items()}
     results = {
-        model: {"flights_per_s": round(args.n / best[model], 1), "compile_s": round(compile_s[model], 1),
+        model: {"flights_per_s": round(1 / best[model], 1), "compile_s": round(compile_s[model], 1),
                 "mean_apogee_agl_m": round(apogee[model], 1)}
         for model in MODELS
     }  # fmt: skip

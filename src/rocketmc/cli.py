@@ -1,9 +1,10 @@
 """The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``aero
-derivatives`` of a rocket, ``validate`` the simulation against a real flight."""
+derivatives`` of a rocket, ``validate`` the simulation against a real flight, ``bench`` this machine."""
 
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
 from pathlib import Path
@@ -15,8 +16,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _run(args) -> int:
-    from .analysis.ellipse import AreaConvergence
-    from .campaign import ConfigError, ResultWriter, ResumeError, load_campaign, run_chunks
+    from .campaign import ConfigError, load_campaign, run_chunks
 
     try:
         campaign = load_campaign(args.campaign).with_overrides(
@@ -25,10 +25,34 @@ def _run(args) -> int:
     except ConfigError as e:
         print(f"rocketmc: error: {args.campaign}: {e}", file=sys.stderr)
         return 2
+    if args.scheduler is None and args.workers is None:
+        return _fly(args, campaign, run_chunks)
+    try:
+        from .campaign import distributed as dask
+    except ModuleNotFoundError as e:
+        if e.name not in ("dask", "distributed"):
+            raise
+        print("rocketmc: error: --workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')",
+              file=sys.stderr)  # fmt: skip
+        return 2
+    try:
+        with dask.cluster(args.scheduler, args.workers) as client:
+            return _fly(args, campaign, functools.partial(dask.run_chunks, client), dask.describe(client))
+    except dask.ClusterError as e:
+        print(f"rocketmc: error: {e}", file=sys.stderr)
+        return 2
+
+
+def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
+    """Fly ``campaign``'s missing chunks with ``run_chunks`` (``campaign.run_chunks`` or its Dask twin,
+    ``where`` describing the cluster) and write the result file."""
+    from .analysis.ellipse import AreaConvergence
+    from .campaign import ResultWriter, ResumeError
+    from .campaign.runner import chunking
+
     cfg = campaign.config
     out = Path(args.out or f"{cfg.name}.h5")
-    chunk_size = min(args.chunk_size or cfg.simulation.chunk_size, cfg.n_realizations)
-    n_chunks = -(-cfg.n_realizations // chunk_size)
+    chunk_size, n_chunks = chunking(campaign, args.chunk_size)
     try:
         writer = ResultWriter(out, campaign, chunk_size, resume=args.resume)
     except ResumeError as e:
@@ -45,6 +69,8 @@ def _run(args) -> int:
 
     log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
         + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
+    if where:
+        log(where)
     flown, seconds, failed = 0, 0.0, 0
     convergence = None if args.until_converged is None else AreaConvergence(args.until_converged / 100.0)
     if convergence is not None:
@@ -64,6 +90,7 @@ def _run(args) -> int:
                 convergence.add(chunk.outputs)
                 if convergence.check():
                     break
+        runs.close()  # a cluster's chunks still in flight are cancelled
         if tty:
             print(file=sys.stderr)  # keep the last progress line
     n_rows = None
@@ -220,6 +247,24 @@ def _validate(args) -> int:
     return 0 if all(c.passed is not False for c in checks) else 1
 
 
+def _bench(args) -> int:
+    from .bench import DEFAULT_CAMPAIGN, BenchError, format_report, run_benchmarks
+    from .campaign import ConfigError
+
+    campaign = args.campaign or DEFAULT_CAMPAIGN
+    try:
+        report = run_benchmarks(campaign, tuple(args.sizes), tuple(args.models), tuple(args.precision),
+                                args.chunk_size, log=lambda line: print(line, file=sys.stderr, flush=True))  # fmt: skip
+    except ConfigError as e:
+        print(f"rocketmc: error: {campaign}: {e}", file=sys.stderr)
+        return 2
+    except BenchError as e:
+        print(f"rocketmc: error: {e}", file=sys.stderr)
+        return 1
+    print(json.dumps(report, indent=2) if args.json else format_report(report))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
     from . import __version__
@@ -240,6 +285,13 @@ def main(argv: list[str] | None = None) -> int:
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
     run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                      help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    cluster = run.add_mutually_exclusive_group()
+    cluster.add_argument("--scheduler", metavar="ADDRESS",
+                         help="fly the chunks on the Dask cluster of this scheduler (tcp://host:8786; needs "
+                              "the 'dask' extra)")  # fmt: skip
+    cluster.add_argument("--workers", type=int, metavar="N",
+                         help="fly the chunks on a local Dask cluster of N worker processes sharing the cores "
+                              "(needs the 'dask' extra)")  # fmt: skip
     report = commands.add_parser("report", help="summarize a result file: ellipses and statistics")
     report.add_argument("file", help="HDF5 result file")
     report.add_argument("--plot", help="write the impact plot with 50/95/99 %% ellipses to this PNG")
@@ -259,13 +311,36 @@ def main(argv: list[str] | None = None) -> int:
     validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
     validate.add_argument("--plot", help="folder for the overlay plots (roccaraso-2021)")
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    bench = commands.add_parser(
+        "bench", help="measure this machine: flights/s, compile time, peak memory, float32 against float64",
+        description="Fly a campaign for each N, aerodynamic model and precision, each in a fresh process: "
+        "flights/s after compilation, compile time, peak resident memory and failed flights; with both precisions, "
+        "the distances between the impact points of the same realizations in float32 and float64; then the vmapped "
+        "batch against single flights in a loop and the interpolated aerodynamics against the simplified, timed "
+        "together. A few minutes with the defaults.",
+    )  # fmt: skip
+    bench.add_argument("--campaign", metavar="FILE", help="campaign file (default: the built-in lynx_nominal)")
+    bench.add_argument("--n", dest="sizes", type=int, nargs="+", default=[1000], metavar="N",
+                       help="numbers of realizations, one measurement each (default: 1000)")  # fmt: skip
+    bench.add_argument("--models", nargs="+", choices=("simplified", "interpolated", "linear"), metavar="MODEL",
+                       default=["simplified", "interpolated"],
+                       help="aerodynamic models among simplified, interpolated, linear "
+                            "(default: simplified interpolated)")  # fmt: skip
+    bench.add_argument("--precision", nargs="+", choices=("float64", "float32"), metavar="PRECISION",
+                       default=["float64", "float32"], help="float64 and/or float32 (default: both)")  # fmt: skip
+    bench.add_argument("--chunk-size", type=int, metavar="C",
+                       help="realizations per compiled chunk (default: the campaign's)")  # fmt: skip
+    bench.add_argument("--json", action="store_true", help="print the results as JSON instead of a table")
     args = parser.parse_args(argv)
+    if min(getattr(args, "sizes", [1])) < 1:
+        parser.error("--n must be at least 1")
     if getattr(args, "until_converged", None) is not None and not args.until_converged > 0:
         parser.error("--until-converged must be a positive percentage")
-    for name in ("n", "chunk_size"):
+    for name in ("n", "chunk_size", "workers"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    return {"run": _run, "report": _report, "aero": _aero_derivatives, "validate": _validate}[args.command](args)
+    return {"run": _run, "report": _report, "aero": _aero_derivatives, "validate": _validate,
+            "bench": _bench}[args.command](args)
 
 
 if __name__ == "__main__":

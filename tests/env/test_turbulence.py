@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from rocketmc.env import Turbulence, advance_turbulence, gust_n, initial_turbulence, turbulence_scales
+from rocketmc.env import Turbulence, advance_turbulence, gust_n, initial_turbulence, turbulence_noise, turbulence_scales
 from rocketmc.env.turbulence import FT, KNOT, high_altitude_scales, low_altitude_scales
 from rocketmc.math import Quat, Vec3
 
@@ -39,11 +39,12 @@ def gust_series(severity, height_m, speed_mps, key):
 
         scales = turbulence_scales(turbulence, height_m)
 
-        def step(state, _):
+        def step(state, noise):
             g = gust_n(state, scales, NORTHWARD, LEVEL)
-            return advance_turbulence(turbulence, state, scales, speed_mps, 1.0 / FS_HZ), g.to_array()
+            return advance_turbulence(state, scales, speed_mps, 1.0 / FS_HZ, noise), g.to_array()
 
-        return jax.lax.scan(step, initial_turbulence(turbulence), None, N_STEPS)[1]
+        noise = turbulence_noise(turbulence, 0, N_STEPS)  # one block: the block length does not matter here
+        return jax.lax.scan(step, initial_turbulence(turbulence), noise)[1]
 
     return jax.vmap(one)(jax.random.split(key, N_SERIES))
 
@@ -138,10 +139,11 @@ def test_frozen_field_at_rest_and_finite_for_tiny_steps():
     turbulence = Turbulence.from_severity(3.0, jax.random.key(5))
     state = initial_turbulence(turbulence)
     scales = turbulence_scales(turbulence, 100.0)
-    still = advance_turbulence(turbulence, state, scales, 0.0, 0.02)  # V = 0: Taylor's field does not move
+    noise = turbulence_noise(turbulence, 0, 1)[0]
+    still = advance_turbulence(state, scales, 0.0, 0.02, noise)  # V = 0: Taylor's field does not move
     for a, b in zip(jax.tree_util.tree_leaves(state.low), jax.tree_util.tree_leaves(still.low)):
         assert float(a) == float(b)
-    crawl = advance_turbulence(turbulence, state, scales, 1e-6, 1e-4)
+    crawl = advance_turbulence(state, scales, 1e-6, 1e-4, noise)
     assert all(np.isfinite(float(x)) for x in jax.tree_util.tree_leaves(crawl))
 
 

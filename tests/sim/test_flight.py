@@ -36,7 +36,7 @@ from rocketmc.sim.flight import (
 )
 from rocketmc.sim.params import SimSettings
 
-N_PERIODS = 3000  # control periods flown by `fly`: ~190-200 s with the 0.1 s descent steps, past every landing
+N_PERIODS = 3000  # control periods flown by `fly`: past every landing (~1650 periods: 0.02 s up, up to 0.25 s under canopy)
 N_BATCH = 3  # realizations compared under vmap and one at a time
 
 
@@ -282,7 +282,7 @@ def test_steady_descent_rate(calm_flight, canopy):
         # the drogue stays attached: both drag areas act
         window = (t > s["main_deploy_time_s"] + float(main.opening_time_s) + 5.0) & (t < s["impact_time_s"])
         cd_s = float(drogue.cd_s_m2 + main.cd_s_m2)
-    assert window.sum() > 100  # a long stretch of descent is tested
+    assert np.ptp(t[window]) > 20.0  # a long stretch of descent is tested [s]
     m = float(mass_properties(p, t[window][0]).mass)
     assert m == pytest.approx(float(p.rocket.dry_mass_kg), abs=1e-15)  # burnt out: dry mass
     rho = np.asarray(isa(float(p.environment.site_altitude_m) + alt[window]).density)
@@ -307,7 +307,7 @@ def test_drifts_with_the_wind_under_the_main(windy_flight):
     t, alt, v = traj.t, -traj.body.r_n.z, traj.body.v_n
     # 150 m below the boundary at ~5.8 m/s: 26 s, ~40 time constants after the wind jump
     window = (alt < 125.0) & (t > s["main_deploy_time_s"]) & (t < s["impact_time_s"])
-    assert window.sum() > 100
+    assert np.ptp(t[window]) > 20.0  # [s]
     wind = p.environment.wind
     # exp(−40)·7.5 m/s is nothing; what remains is the decaying swing of the body under its canopies
     # (measured 1e-9 m/s): 1e-6 m/s.

@@ -62,6 +62,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .geometry import FinSet, RocketGeometry
 from .tables import PANEL_AXES, PANEL_COEFFS, CanardPanels, GriddedCoefficients
@@ -143,7 +144,8 @@ def slender_body_factors(count: int, tau: float, vortices_per_panel: int = 80) -
     influence = np.real(np.conj(conj_vel) * np.conj(n_c)[:, None])  # normal velocity per unit Γ
 
     def loads(free_normal_velocity):
-        gamma = np.linalg.solve(influence, -free_normal_velocity).reshape(count, m)
+        with threadpool_limits(1):  # LAPACK's result depends on its BLAS threads: the same bits on every machine
+            gamma = np.linalg.solve(influence, -free_normal_velocity).reshape(count, m)
         panel = (gamma * (r_vortex - a)).sum(axis=1)
         body = (gamma * (a - a**2 / r_vortex)).sum(axis=1)
         roll = (gamma * (r_vortex**2 - a**2) / 2).sum(axis=1)

@@ -214,8 +214,10 @@ def linear_coefficients(aero: LinearAero, air: AirData, deflections, burning=Fal
     control = values[k : k + 5 * n].reshape(5, n)
     quadratic = values[k + 5 * n :].reshape(n, n)
     delta = jnp.asarray(deflections)
-    d_cy, d_cn, d_cl, d_cm, d_cn_yaw = control @ delta if n else jnp.zeros(5)
-    ca = aero.drag_scale * (c["CA0"] + power_on_axial(aero, air, burning)) + (delta @ quadratic @ delta if n else 0.0)
+    # elementwise sums, not ``@``: a vmapped dot of a few numbers is a slow library call on CPU
+    d_cy, d_cn, d_cl, d_cm, d_cn_yaw = jnp.sum(control * delta, axis=1) if n else jnp.zeros(5)
+    drag_delta = jnp.sum(quadratic * delta[:, None] * delta[None, :]) if n else 0.0
+    ca = aero.drag_scale * (c["CA0"] + power_on_axial(aero, air, burning)) + drag_delta
     coefficients = AeroCoefficients(
         ca,
         -c["CNa"] * air.beta + d_cy,

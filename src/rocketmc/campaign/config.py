@@ -373,7 +373,10 @@ class Dispersion(_Strict):
 class SimulationConfig(_Strict):
     control_dt_s: float = Field(0.02, gt=0, le=0.1, description="GNC period")
     substeps: int = Field(1, ge=1, le=100, description="RK4 steps per control period")
-    descent_dt_s: float = Field(0.1, gt=0, le=1.0, description="longest period in steady descent under canopy")
+    descent_dt_s: float = Field(0.25, gt=0, le=1.0, description="longest period in steady descent under canopy")
+    descent_h_omega: float = Field(
+        1.0, gt=0, le=2.0, description="largest RK4 step times the body's pendulum rate under canopy (RK4 is stable to 2.8)"
+    )
     max_time_s: Positive = 300.0
     chunk_size: int = Field(1000, ge=1, description="realizations per compiled batch")
 

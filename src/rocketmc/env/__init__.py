@@ -8,6 +8,7 @@ from .turbulence import TurbulenceState as TurbulenceState
 from .turbulence import advance_turbulence as advance_turbulence
 from .turbulence import gust_n as gust_n
 from .turbulence import initial_turbulence as initial_turbulence
+from .turbulence import turbulence_noise as turbulence_noise
 from .turbulence import turbulence_scales as turbulence_scales
 from .wind import PowerLawWind as PowerLawWind
 from .wind import WindLayers as WindLayers

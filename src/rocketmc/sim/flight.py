@@ -19,7 +19,9 @@ from ..aero import aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
-from ..env import G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, isa, turbulence_scales
+from ..env import (
+    G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, isa, turbulence_noise, turbulence_scales,
+)  # fmt: skip
 from ..env.atmosphere import MAX_ALTITUDE_M
 from ..math import Quat, Vec3, rk4_step
 from ..pytree import pytree_dataclass, tree_where
@@ -290,16 +292,19 @@ def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
     return any_open & ~transient
 
 
-def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections) -> FlightState:
+def control_step(
+    p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections, noise=None
+) -> FlightState:
     """One control period with canard deflections δ1..δn [rad] and the turbulent gust held: RK4
     substeps of the rigid body with events (the GNC will compute ``deflections`` from the state),
-    then the turbulence filters advanced over the period.
+    then the turbulence filters advanced over the period with ``noise``, the period's row of
+    ``block_noise`` (None without turbulence).
 
     The period is ``settings.control_dt_s``; in steady descent under canopy it grows up to
-    ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ 0.5.
+    ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ ``settings.descent_h_omega``.
     Each realization keeps its own clock.
     """
-    stable_period = settings.substeps * 0.5 / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
+    stable_period = settings.substeps * settings.descent_h_omega / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
     descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
     period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
     h = period / settings.substeps
@@ -328,31 +333,48 @@ def control_step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: F
     filters = state.turbulence
     if turbulence is not None:
         airspeed = (state.body.v_n - mean_wind_n - gust).norm()
-        filters = advance_turbulence(turbulence, filters, scales, airspeed, period)
+        filters = advance_turbulence(filters, scales, airspeed, period, noise)
     return FlightState(state.t + period, body, events, stiffness, filters)
 
 
 def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
     """Fly until landed, stopped or ``settings.max_time_s``; return (summary dict, status code).
 
-    The loop runs in blocks of ``settings.block_steps`` control periods; under ``vmap`` the batch
-    stops as soon as every member is done.
+    The loop runs in blocks of ``settings.block_steps`` control periods (``fly_block``).
     """
 
-    start_n = rail_start_n(p)
-    neutral = jnp.zeros(p.rocket.aero.n_canards)
+    def block(carry):
+        state, index = carry
+        return fly_block(p, settings, state, index), index + 1
 
-    def block(state):
-        def step(s, _):
-            return control_step(p, settings, start_n, s, neutral), None
-
-        return jax.lax.scan(step, state, None, settings.block_steps)[0]
-
-    def keep_going(state):
-        return ~done(state) & (state.t < settings.max_time_s)
-
-    final = jax.lax.while_loop(keep_going, block, initial_state(p))
+    final, _ = jax.lax.while_loop(
+        lambda carry: ~flight_done(settings, carry[0]), block, (initial_state(p), jnp.zeros((), jnp.uint32))
+    )
     return flight_summary(p, final)
+
+
+def flight_done(settings: SimSettings, state: FlightState):
+    """True once the flight has landed, stopped on a non-finite state or reached ``settings.max_time_s``."""
+    return done(state) | (state.t >= settings.max_time_s)
+
+
+def fly_block(p: FlightParams, settings: SimSettings, state: FlightState, index) -> FlightState:
+    """The flight ``settings.block_steps`` control periods (block ``index`` of its flight) later,
+    canards neutral."""
+    start_n, neutral = rail_start_n(p), jnp.zeros(p.rocket.aero.n_canards)
+
+    def step(s, noise):
+        return control_step(p, settings, start_n, s, neutral, noise), None
+
+    return jax.lax.scan(step, state, block_noise(p, index, settings.block_steps), settings.block_steps)[0]
+
+
+def block_noise(p: FlightParams, index, n_periods: int):
+    """The turbulence's white noise for block ``index`` of ``n_periods`` control periods,
+    (n_periods, 10), or None without turbulence. Blocks are ``settings.block_steps`` long in
+    ``fly_block`` and ``fly`` alike, so both fly the same gusts."""
+    turbulence = p.environment.turbulence
+    return None if turbulence is None else turbulence_noise(turbulence, index, n_periods)
 
 
 def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=None):
@@ -366,12 +388,23 @@ def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=N
     start_n = rail_start_n(p)
     neutral = jnp.zeros(p.rocket.aero.n_canards)
 
-    def step(s, _):
+    def step(s, noise):
         deflections = neutral if canard_command is None else jnp.asarray(canard_command(s.t), dtype=float)
-        s = control_step(p, settings, start_n, s, deflections)
+        s = control_step(p, settings, start_n, s, deflections, noise)
         return s, s
 
-    return jax.lax.scan(step, initial_state(p), None, n_periods)
+    def block(s, index, length):  # the first ``length`` periods of block ``index``
+        noise = block_noise(p, index, settings.block_steps)
+        return jax.lax.scan(step, s, None if noise is None else noise[:length], length)
+
+    full, rest = divmod(n_periods, settings.block_steps)
+    blocks = jnp.arange(full, dtype=jnp.uint32)
+    state, trajectory = jax.lax.scan(lambda s, i: block(s, i, settings.block_steps), initial_state(p), blocks)
+    trajectory = jax.tree_util.tree_map(lambda x: x.reshape(-1, *x.shape[2:]), trajectory)
+    if rest:
+        state, tail = block(state, jnp.uint32(full), rest)
+        trajectory = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a, b]), trajectory, tail)
+    return state, trajectory
 
 
 def unit_of(name: str) -> str:

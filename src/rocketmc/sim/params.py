@@ -79,14 +79,16 @@ class SimSettings:
 
     control_dt_s: control period, the GNC rate [s]; substeps: RK4 steps per control period;
     descent_dt_s: the longer period used under a fully open canopy, once opening transients have
-    settled (``settle_s`` after full opening); the GNC is idle then [s];
+    settled (``settle_s`` after full opening); the GNC is idle then [s]; ``descent_h_omega``: the
+    largest RK4 step h times the body's pendulum rate ω under its canopies there;
     max_time_s: a flight not on the ground by then gets the status MAX_TIME;
     block_steps: control periods per chunk of work between checks that the whole batch has landed.
     """
 
     control_dt_s: float = 0.02
     substeps: int = 1
-    descent_dt_s: float = 0.1
+    descent_dt_s: float = 0.25
+    descent_h_omega: float = 1.0
     settle_s: float = 1.0
     max_time_s: float = 300.0
-    block_steps: int = 250
+    block_steps: int = 100

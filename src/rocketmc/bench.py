@@ -1,0 +1,289 @@
+"""Benchmarks of a campaign on this machine (``rocketmc bench``, benchmarks/, tests/test_performance.py).
+
+- throughput: flights per second after compilation, compile time [s] and peak memory [MB] for each
+  aerodynamic model, precision and N;
+- float32 against float64: their speeds, and the distances between the impact points of the same
+  realizations flown in both;
+- issue 6's ratios, timed together in one process: the vmapped batch against single flights in a
+  loop, the interpolated aerodynamics against the simplified.
+
+Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
+resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
+when rocketmc is imported) can choose float32.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from importlib import metadata, resources
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from . import PRECISION
+from .analysis.ellipse import confidence_ellipse
+from .campaign import load_campaign, run_chunks
+from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings
+from .sim.flight import Status
+
+DEFAULT_CAMPAIGN = Path(str(resources.files("rocketmc") / "data" / "campaigns" / "lynx_nominal.toml"))
+MODELS = ("simplified", "interpolated")
+PRECISIONS = ("float64", "float32")
+LOOP_FLIGHTS = 8
+"""Single flights per timed loop (lynx_nominal: ~0.05–0.1 s each on the 2-core machine)."""
+QUEUE_PER_LANE = 8
+"""Flights per lane in the timed batch: 1024 on 2 cores, about the default chunk (1000)."""
+
+
+# --- measurements (in the measuring process) -----------------------------------------------------
+
+
+def single_flights(campaign) -> Callable:
+    """``f(master_key, indices)``: the realizations flown one at a time, a compiled single flight
+    (``jit`` of ``runner.realization``, one device) called in a Python loop."""
+    settings = sim_settings(campaign)
+    key = jax.random.key(campaign.config.seed)
+    one = jax.jit(lambda k, i: realization(campaign, settings, k, i)).lower(key, np.uint32(0)).compile()
+    return lambda master_key, indices: [jax.block_until_ready(one(master_key, i)) for i in indices]
+
+
+def seconds_per_flight(functions: dict[str, tuple[Callable, int]], master_key, repeats: int) -> dict[str, float]:
+    """Best wall time per flight [s] of each ``name: (f, n)``, ``f(master_key, indices 0..n-1)``, over
+    ``repeats`` rounds that interleave the functions (so that machine noise hits all alike)."""
+    best = dict.fromkeys(functions, float("inf"))
+    for _ in range(repeats):
+        for name, (f, n) in functions.items():
+            indices = np.arange(n, dtype=np.uint32)
+            t0 = time.perf_counter()
+            jax.block_until_ready(f(master_key, indices))
+            best[name] = min(best[name], (time.perf_counter() - t0) / n)
+    return best
+
+
+def ratios(campaign, repeats: int = 3) -> dict:
+    """Issue 6's ratios on ``campaign``: seconds per flight [s] of ``LOOP_FLIGHTS`` simplified single
+    flights in a loop and of a vmapped batch (a queue of ``QUEUE_PER_LANE`` flights per lane, as a
+    chunk flies them)
+    with each model; ``loop_over_batch`` (simplified) and ``interpolated_over_simplified`` (batches).
+    The three functions are compiled concurrently (XLA compiles outside the GIL), then timed together."""
+    simplified, interpolated = (campaign.with_overrides(aero_model=m) for m in ("simplified", "interpolated"))
+    batch = batch_size(QUEUE_PER_LANE * GROUP * jax.local_device_count())
+    with ThreadPoolExecutor() as pool:
+        compiling = {
+            "loop": (pool.submit(single_flights, simplified), LOOP_FLIGHTS),
+            "simplified": (pool.submit(compile_chunk, simplified, batch), batch),
+            "interpolated": (pool.submit(compile_chunk, interpolated, batch), batch),
+        }
+        functions = {name: (f.result(), n) for name, (f, n) in compiling.items()}
+    s = seconds_per_flight(functions, jax.random.key(campaign.config.seed), repeats)
+    return {"loop_flights": LOOP_FLIGHTS, "batch": batch, "s_per_flight": s,
+            "loop_over_batch": s["loop"] / s["simplified"],
+            "interpolated_over_simplified": s["interpolated"] / s["simplified"]}  # fmt: skip
+
+
+@contextlib.contextmanager
+def float32_draws():
+    """Make ``jax.random``'s normal, uniform and categorical draw in float32 (then cast to the
+    requested dtype) while a campaign is compiled. A float64 draw takes 64 random bits and a float32
+    one 32, so the two precisions otherwise fly different realizations from the same seed; with this,
+    float64 flies exactly the dispersions and gusts that float32 draws."""
+    normal, uniform, categorical = jax.random.normal, jax.random.uniform, jax.random.categorical
+    jax.random.normal = lambda key, shape=(), dtype=float: normal(key, shape, jnp.float32).astype(dtype)
+    jax.random.uniform = lambda key, shape=(), dtype=float, minval=0.0, maxval=1.0: uniform(
+        key, shape, jnp.float32, minval, maxval
+    ).astype(dtype)
+    jax.random.categorical = lambda key, logits, *args, **kwargs: categorical(
+        key, jnp.asarray(logits, jnp.float32), *args, **kwargs
+    )
+    try:
+        yield
+    finally:
+        jax.random.normal, jax.random.uniform, jax.random.categorical = normal, uniform, categorical
+
+
+def throughput(campaign, chunk_size: int | None = None, impacts: str | None = None) -> dict:
+    """Fly ``campaign`` with ``run_chunks``: chunk size, compile time [s], wall time of the chunks
+    after it [s], flights/s, ok flights and the count of each failure status; ``impacts``: also save
+    the impact points, status and drawn inputs in this ``.npz`` file."""
+    t0 = time.perf_counter()
+    runs = run_chunks(campaign, chunk_size)
+    compile_s = next(runs)
+    keys = ("impact_north_m", "impact_east_m", "status") if impacts else ("status",)
+    kept = [{k: c.outputs[k] for k in keys} | (c.inputs if impacts else {}) for c in runs]
+    run_s = time.perf_counter() - t0 - compile_s
+    flown = {k: np.concatenate([c[k] for c in kept]) for k in kept[0]}
+    if impacts:
+        np.savez(impacts, **flown)
+    codes, counts = np.unique(flown["status"], return_counts=True)
+    return {"chunk_size": chunking(campaign, chunk_size)[0], "compile_s": compile_s, "run_s": run_s,
+            "flights_per_s": campaign.config.n_realizations / run_s, "ok": int(counts[codes == 0].sum()),
+            "failed": {Status(c).name: int(k) for c, k in zip(codes, counts) if c != 0}}  # fmt: skip
+
+
+def _measure(spec: dict) -> dict:
+    """One measurement in this process (``spec`` from ``_subprocess``), with this process's
+    precision and peak resident memory [MB]."""
+    campaign = load_campaign(spec["campaign"])
+    if spec["kind"] == "ratios":
+        result = ratios(campaign)
+    else:
+        campaign = campaign.with_overrides(n_realizations=spec["n"], aero_model=spec["model"])
+        with float32_draws() if spec["float32_draws"] else contextlib.nullcontext():
+            result = throughput(campaign, spec["chunk_size"], spec["impacts"])
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # kB on Linux, bytes on macOS
+    return {**result, "precision": PRECISION, "peak_rss_mb": rss / (2**20 if sys.platform == "darwin" else 2**10)}
+
+
+# --- orchestration (in the calling process) ------------------------------------------------------
+
+
+class BenchError(RuntimeError):
+    """A measuring process failed; the message is one line."""
+
+
+def _subprocess(precision: str, **spec) -> dict:
+    """``_measure(spec)`` in a fresh process with ``ROCKETMC_PRECISION=precision``."""
+    env = {**os.environ, "ROCKETMC_PRECISION": precision}
+    command = [sys.executable, "-m", "rocketmc.bench", json.dumps(spec)]
+    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
+        what = spec["kind"] if spec["kind"] == "ratios" else f"{spec['model']}, N = {spec['n']}"
+        raise BenchError(f"the measurement ({what}, {precision}) failed: {last}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _impact_difference(float64_npz: str, float32_npz: str) -> dict:
+    """Distances [m] between the impact points of the same realizations flown in both precisions
+    (ok in both), the largest relative difference of their drawn inputs (float32 rounding: ~1e-7),
+    and the two 95 % ellipses' areas [m²]."""
+    a, b = np.load(float64_npz), np.load(float32_npz)
+    ok = (a["status"] == 0) & (b["status"] == 0)
+    d = np.hypot(a["impact_north_m"][ok] - b["impact_north_m"][ok], a["impact_east_m"][ok] - b["impact_east_m"][ok])
+    inputs = [k for k in a.files if k not in ("impact_north_m", "impact_east_m", "status")]
+    area = {p: confidence_ellipse(x["impact_north_m"][ok], x["impact_east_m"][ok]).area_m2
+            for p, x in (("float64", a), ("float32", b))}  # fmt: skip
+    return {
+        "compared": int(ok.sum()),
+        "status_differs": int((a["status"] != b["status"]).sum()),
+        "inputs_max_relative_difference": max(
+            float(np.max(np.abs(a[k] - b[k]) / np.maximum(np.abs(a[k]), np.finfo(float).tiny))) for k in inputs
+        ),
+        "impact_difference_m": {"median": float(np.median(d)), "p95": float(np.percentile(d, 95)),
+                                "max": float(d.max())},
+        "ellipse95_area_m2": {**area, "relative_difference": area["float32"] / area["float64"] - 1.0},
+    }  # fmt: skip
+
+
+def machine() -> dict:
+    """CPU, core count, XLA devices and versions of this machine."""
+    cpuinfo = Path("/proc/cpuinfo")
+    lines = cpuinfo.read_text().splitlines() if cpuinfo.exists() else []
+    names = [line.split(":", 1)[1].strip() for line in lines if line.startswith("model name")]
+    return {
+        "cpu": names[0] if names else platform.processor(),
+        "cores": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
+        "devices": jax.local_device_count(),
+        "platform": jax.default_backend(),
+        "python": platform.python_version(),
+        "jax": jax.__version__,
+        "jaxlib": metadata.version("jaxlib"),
+    }
+
+
+def run_benchmarks(
+    campaign: str | Path = DEFAULT_CAMPAIGN,
+    sizes: tuple[int, ...] = (1000,),
+    models: tuple[str, ...] = MODELS,
+    precisions: tuple[str, ...] = PRECISIONS,
+    chunk_size: int | None = None,
+    log: Callable[[str], None] = lambda line: None,
+) -> dict:
+    """Every (N, model, precision) throughput measurement, then the ratios (in the first precision),
+    each in its own process; ``log`` receives one line per measurement. With both precisions, the
+    float64 run of the smallest N and first model flies float32's draws (``float32_draws``), and the
+    report compares their impact points. Raises ConfigError for a bad campaign or model."""
+    path = str(Path(campaign).resolve())
+    base = load_campaign(path)
+    for model in dict.fromkeys((*models, *MODELS)):  # the ratios fly both MODELS
+        base.with_overrides(aero_model=model)  # a model the campaign cannot fly fails here
+    report = {"campaign": base.config.name, "campaign_file": path, "machine": machine(), "measurements": []}
+    compared = (min(sizes), models[0]) if set(PRECISIONS) <= set(precisions) else None
+    with tempfile.TemporaryDirectory() as tmp:
+        impacts = {p: str(Path(tmp) / f"{p}.npz") for p in PRECISIONS}
+        for n in sizes:
+            for model in models:
+                for precision in precisions:
+                    same = (n, model) == compared
+                    r = {"model": model, "n": n, "float32_draws": same and precision == "float64"}
+                    r |= _subprocess(precision, kind="throughput", campaign=path, chunk_size=chunk_size,
+                                     impacts=impacts[precision] if same else None, **r)  # fmt: skip
+                    report["measurements"].append(r)
+                    log(f"{model} {precision} N = {n}: compile {r['compile_s']:.1f} s, {r['flights_per_s']:.0f} "
+                        f"flights/s, {r['ok']} ok, peak RSS {r['peak_rss_mb']:.0f} MB")  # fmt: skip
+        if compared:
+            c = _impact_difference(impacts["float64"], impacts["float32"])
+            report["float32_vs_float64"] = {"n": compared[0], "model": compared[1], **c}
+            log(f"float32 against float64 on the same realizations: impact points "
+                f"{c['impact_difference_m']['median']:.2f} m apart (median)")  # fmt: skip
+    r = report["ratios"] = _subprocess(precisions[0], kind="ratios", campaign=path)
+    log(f"ratios ({precisions[0]}): batch {r['loop_over_batch']:.1f}x faster per flight than a loop, "
+        f"interpolated {r['interpolated_over_simplified']:.2f}x the simplified")  # fmt: skip
+    return report
+
+
+def format_report(report: dict) -> str:
+    """The report as a readable table and a few sentences."""
+    m = report["machine"]
+    lines = [
+        f"{report['campaign']}: {m['cpu']}, {m['cores']} cores ({m['devices']} XLA {m['platform']} devices), "
+        f"jax {m['jax']}, Python {m['python']}",
+        f"  {'model':<13}{'precision':<10}{'N':>8}{'chunk':>7}{'compile s':>11}{'run s':>9}{'flights/s':>11}"
+        f"{'ok':>8}{'peak RSS MB':>13}  failed",
+    ]  # fmt: skip
+    rows = report["measurements"]
+    for r in rows:
+        failed = ", ".join(f"{name} {k}" for name, k in r["failed"].items()) or "-"
+        lines.append(f"  {r['model']:<13}{r['precision']:<10}{r['n']:>8}{r['chunk_size']:>7}{r['compile_s']:>11.1f}"
+                     f"{r['run_s']:>9.1f}{r['flights_per_s']:>11.1f}{r['ok']:>8}{r['peak_rss_mb']:>13.0f}"
+                     f"  {failed}")  # fmt: skip
+    rate = {(r["model"], r["precision"], r["n"]): r["flights_per_s"] for r in rows}
+    lines += [f"  interpolated / simplified cost per flight ({p}, N = {n}, separate runs): "
+              f"{rate['simplified', p, n] / fps:.2f}x"
+              for (model, p, n), fps in rate.items()
+              if model == "interpolated" and ("simplified", p, n) in rate]  # fmt: skip
+    lines += [f"  float32 / float64 speed ({model}, N = {n}): {fps / rate[model, 'float64', n]:.2f}x"
+              for (model, p, n), fps in rate.items() if p == "float32" and (model, "float64", n) in rate]  # fmt: skip
+    if "float32_vs_float64" in report:
+        c = report["float32_vs_float64"]
+        d, a = c["impact_difference_m"], c["ellipse95_area_m2"]
+        lines.append(
+            f"  float32 against float64 on the same realizations ({c['model']}, N = {c['n']}, {c['compared']} ok in "
+            f"both, {c['status_differs']} with another status): impact points {d['median']:.2f} m apart (median), "
+            f"{d['p95']:.2f} m (95th percentile), {d['max']:.2f} m (max); 95 % ellipse area {a['float32'] / 1e6:.4f} "
+            f"km² against {a['float64'] / 1e6:.4f} km² ({100 * a['relative_difference']:+.3f} %)"
+        )
+    r = report["ratios"]
+    s = r["s_per_flight"]
+    lines.append(
+        f"  timed together ({r['precision']}): a vmapped batch of {r['batch']} flies {r['loop_over_batch']:.1f}x "
+        f"faster per flight than {r['loop_flights']} single flights in a loop ({1e3 * s['simplified']:.2f} against "
+        f"{1e3 * s['loop']:.1f} ms, simplified); interpolated / simplified {r['interpolated_over_simplified']:.2f}x"
+    )
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":  # one measurement: python -m rocketmc.bench SPEC (JSON); its result on stdout
+    print(json.dumps(_measure(json.loads(sys.argv[1]))))

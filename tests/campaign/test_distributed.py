@@ -1,0 +1,156 @@
+"""Runs on Dask (``run --workers N`` / ``--scheduler ADDRESS``): a two-worker local cluster writes the
+bits of a local run, also when resuming, stopping early or losing a worker mid-run; a scheduler that
+cannot be reached, a missing 'dask' extra and bad options are one line and exit code 2."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import dask
+import jax
+import numpy as np
+import pytest
+
+import rocketmc.campaign
+from rocketmc.campaign import ResultWriter, load_campaign
+from rocketmc.campaign import distributed as dask_runner
+from rocketmc.campaign.runner import ChunkResult
+from rocketmc.cli import main
+
+from ..conftest import CAMPAIGNS
+from .test_resume import contents
+
+CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic.toml")
+N, CHUNK, SEED = 16, 2, 7  # 8 chunks of ~0.5 s on one worker core once compiled
+ARGS = ["-n", str(N), "--chunk-size", str(CHUNK), "--seed", str(SEED)]
+
+
+def assert_same(got: dict, want: dict) -> None:
+    assert got.keys() == want.keys()
+    for name in want:
+        np.testing.assert_array_equal(got[name], want[name], err_msg=name)  # bit-identical, NaNs included
+
+
+def test_two_workers_write_the_local_bits(tmp_path, monkeypatch):
+    # One test for the whole cluster: pytest-xdist may split a module's tests between its processes,
+    # and each would start its own cluster (one compilation per worker, ~30 s on one core).
+    assert main(["run", CAMPAIGN, *ARGS, "--out", str(tmp_path / "local.h5"), "--quiet"]) == 0
+    want, want_attrs = contents(tmp_path / "local.h5")
+    # A worker restarted after a kill loads the chunk function from JAX's disk cache (seconds)
+    # instead of compiling it again; the first ones compile as usual.
+    monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", str(tmp_path / "jax_cache"))
+    # Starting the cluster sets Dask's pre-spawn variables (OMP_NUM_THREADS=1, ...) in this process for
+    # good: restored after this test, so that later tests' subprocesses do not inherit them. The workers
+    # run with them: the bits must not depend on BLAS threads (aero.buildup pins its LAPACK solve to one).
+    for name, value in dask.config.get("distributed.nanny.pre-spawn-environ").items():
+        monkeypatch.setenv(name, str(value))
+    with dask_runner.cluster(workers=2) as client:  # as `run --workers 2` starts it
+        # Each worker has half of this machine's XLA devices (at least 1), so its batches are padded
+        # otherwise than the local run's: the bits must not depend on it.
+        assert client.run(jax.local_device_count) == dict.fromkeys(client.nthreads(), max(1, jax.local_device_count() // 2))
+        address = client.scheduler_info()["address"]
+        assert main(["run", CAMPAIGN, *ARGS, "--out", str(tmp_path / "dask.h5"), "--quiet", "--scheduler", address]) == 0
+        got, got_attrs = contents(tmp_path / "dask.h5")
+        assert_same(got, want)
+        assert got_attrs["campaign_toml"] == want_attrs["campaign_toml"]
+        assert list(got_attrs["completed_chunks"]) == list(range(N // CHUNK))
+
+        campaign = load_campaign(CAMPAIGN).with_overrides(n_realizations=N, seed=SEED)
+        resumes(address, campaign, want, tmp_path / "resumed.h5")
+        stops_early(client, campaign)
+        refuses_workers_unlike_the_client(client, campaign)
+        survives_a_killed_worker(client, campaign, want)  # last: the restarted worker compiles again
+
+
+def resumes(address: str, campaign, want: dict, out) -> None:
+    """A killed run left chunks 0, 3 and 5 (taken from the local run): the cluster flies the others,
+    out of the usual order, and the file is the local run's."""
+    writer = ResultWriter(out, campaign, CHUNK)
+    for index in (0, 3, 5):
+        rows = slice(CHUNK * index, CHUNK * (index + 1))
+        part = {group: {k.split("/")[1]: v[rows] for k, v in want.items() if k.startswith(group)} for group in ("outputs", "inputs")}
+        writer.write(ChunkResult(CHUNK * index, part["outputs"], part["inputs"], 0.0), index)
+    assert main(["run", CAMPAIGN, *ARGS, "--out", str(out), "--quiet", "--resume", "--scheduler", address]) == 0
+    assert_same(contents(out)[0], want)
+
+
+def stops_early(client, campaign) -> None:
+    """A consumer that stops after the first chunk (--until-converged) leaves no task of the run on the
+    cluster."""
+    runs = dask_runner.run_chunks(client, campaign, CHUNK)
+    next(runs)  # the compile time
+    assert next(runs).start == 0
+    runs.close()
+    deadline = time.monotonic() + 10  # releases travel on the client's batched stream, flushed every few ms
+    while (left := client.run_on_scheduler(tasks_of_rocketmc)) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert left == []
+
+
+def tasks_of_rocketmc(dask_scheduler) -> list:
+    return [key for key in dask_scheduler.tasks if "rocketmc-chunk" in str(key)]
+
+
+def refuses_workers_unlike_the_client(client, campaign) -> None:
+    """A worker of another rocketmc version refuses the chunk before compiling (exit code 2 in the CLI)."""
+    future = client.submit(dask_runner._fly, campaign, "token", CHUNK, 0, ("0.0.0", jax.__version__, True))
+    with pytest.raises(dask_runner.ClusterError, match="the bits would differ"):
+        future.result()
+
+
+def survives_a_killed_worker(client, campaign, want: dict) -> None:
+    """A worker killed mid-run costs the chunks it held, flown again by the other; the chunks received
+    before are not."""
+    pids = client.run(os.getpid)
+    runs = dask_runner.run_chunks(client, campaign, CHUNK)
+    next(runs)  # the compile time
+    first = next(runs)
+    victim, keys = next((worker, keys) for worker, keys in client.processing().items() if keys)  # 7 chunks left
+    os.kill(pids[victim], signal.SIGKILL)
+    chunks = [first, *runs]
+    got = {f"{group}/{name}": np.concatenate([getattr(c, group)[name] for c in chunks])
+           for group in ("outputs", "inputs") for name in getattr(first, group)}  # fmt: skip
+    assert_same(got, want)
+
+    run = keys[0][0]  # this run's task keys: (run, chunk index)
+    story = client.run_on_scheduler(lambda dask_scheduler: [(key, finish) for key, _, finish, *_ in dask_scheduler.transition_log
+                                                            if isinstance(key, tuple) and key[0] == run])  # fmt: skip
+    flown = {index: sum(finish == "processing" for (_, i), finish in story if i == index) for index in range(N // CHUNK)}
+    assert flown[0] == 1  # received before the kill: not flown again
+    assert any(n > 1 for n in flown.values())  # the victim's chunk(s) were flown again
+
+
+def test_the_campaign_digest_is_the_same_in_every_process():
+    # The workers' compiled functions are kept under it, for the next runs of the campaign.
+    code = f"from rocketmc.campaign import load_campaign, distributed; print(distributed.digest(load_campaign({CAMPAIGN!r})))"
+    digest = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert digest == dask_runner.digest(load_campaign(CAMPAIGN))
+
+
+def test_unreachable_scheduler_is_one_line(tmp_path, capsys, monkeypatch):
+    with socket.socket() as s:  # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    monkeypatch.setattr(dask_runner, "CONNECT_TIMEOUT_S", 1.0)  # a refused connection is retried until the timeout
+    assert main(["run", CAMPAIGN, "-n", "8", "--out", str(tmp_path / "run.h5"), "--scheduler", f"tcp://127.0.0.1:{port}"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rocketmc: error: --scheduler tcp://127.0.0.1:{port}: no Dask scheduler") and err.count("\n") == 1
+    assert not list(tmp_path.iterdir())  # no partial run left to resume
+
+
+def test_missing_extra_and_bad_options(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed: importing it raises
+    monkeypatch.delitem(sys.modules, "rocketmc.campaign.distributed")
+    monkeypatch.delattr(rocketmc.campaign, "distributed")
+    assert main(["run", CAMPAIGN, "-n", "8", "--out", str(tmp_path / "run.h5"), "--workers", "2"]) == 2
+    assert capsys.readouterr().err == ("rocketmc: error: --workers/--scheduler need the optional 'dask' extra "
+                                       "(pip install 'rocketmc[dask]')\n")  # fmt: skip
+    for options in (["--workers", "0"], ["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"]):
+        with pytest.raises(SystemExit) as exit:
+            main(["run", CAMPAIGN, *options])
+        assert exit.value.code == 2 and capsys.readouterr().err.count("\n") == 1
