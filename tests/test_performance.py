@@ -3,7 +3,7 @@
 Marked ``performance``: ``make test`` runs them alone after the parallel suite, since another test
 process on the same cores would bias the timings. ``rocketmc.bench.ratios`` compiles the three
 flight functions first, then times them in interleaved rounds (best of each), so that machine noise
-hits them alike. About two minutes on the 2-core machine (three compilations, then 1024-flight batches); ``-s`` prints the ratios.
+hits them alike. About a minute on the 2-core machine (three compilations, then 1024-flight batches); ``-s`` prints the ratios.
 """
 
 from __future__ import annotations
@@ -17,17 +17,12 @@ pytestmark = pytest.mark.performance
 
 @pytest.fixture(scope="module")
 def measured(lynx_campaign):
-    r = ratios(lynx_campaign)
+    r = ratios(lynx_campaign, repeats=5)  # best of 5 interleaved rounds: this VM's noise comes in bursts of seconds
     print(f"\nbatch of {r['batch']} against a loop of {r['loop_flights']}: {r['loop_over_batch']:.1f}x faster per "
           f"flight; interpolated / simplified: {r['interpolated_over_simplified']:.2f}x")  # fmt: skip
     return r
 
 
-@pytest.mark.xfail(
-    reason="issue 6 is open on this bound: measured 14.6x (a batch of 1024 at 3.3 ms per flight, single flights "
-    "48 ms; docs/performance.md)",
-    strict=False,
-)
 def test_vmapped_batch_at_least_20x_faster_per_flight_than_a_loop(measured):
     # 20x is the issue's bound, and the reason to vectorise: a batch spreads XLA's per-operation cost
     # over the SIMD lanes and flies on every core. A regression that serialises the batch (a lost
