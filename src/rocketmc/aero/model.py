@@ -15,7 +15,6 @@ those of ``aero.tables`` (body frame FRD, forces q̄S(−CA, CY, −CN), moments
 
 from __future__ import annotations
 
-import functools
 from typing import NamedTuple
 
 import jax
@@ -201,7 +200,8 @@ def table_coefficients(aero: TableAero, air: AirData, omega_hat: Vec3, cg_x_m, d
         cl = cl - sum(panel_cr[j] for j in panels)
         cm = cm - arm * force_z
         cn_yaw = cn_yaw + arm * force_y
-        out_of_range = functools.reduce(jnp.logical_or, [out_of_range, *panel_out])
+        for j in panels:
+            out_of_range = out_of_range | panel_out[j]
     coefficients = AeroCoefficients(
         aero.drag_scale * (ca + power_on_axial(aero, air, burning)), cy, cn, cl + aero.cl0, cm, cn_yaw,
         body["CNq"], body["Cmq"], body["CYr"], body["Cnr"], body["Clp"],

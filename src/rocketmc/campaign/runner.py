@@ -56,8 +56,8 @@ LANES = 8
 
 GROUP = 64
 """Flights flown side by side (vmapped lanes) on each device; a lane whose flight is done takes the
-device's next one (``simulate_queue``). Measured on lynx_nominal, 2 cores: a lane-step costs
-3.5 µs at 64 lanes, 4.2 µs at 256 (cache), and 32 lanes were slower overall."""
+device's next one (``simulate_queue``). Measured on lynx_nominal, 2 cores: 32 lanes were slower
+overall, and since the RK4 loop 128 or 256 lanes are within noise of 64 (docs/performance.md)."""
 
 
 def batch_size(chunk_size: int) -> int:
