@@ -6,8 +6,14 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import os
+import signal
 import sys
 from pathlib import Path
+
+from .env.atmosphere import MAX_ALTITUDE_M
+from .errors import RocketmcError
+from .files import file_stem
 
 
 class _Parser(argparse.ArgumentParser):
@@ -16,15 +22,9 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _run(args) -> int:
-    from .campaign import ConfigError, load_campaign, run_chunks
+    from .campaign import run_chunks
 
-    try:
-        campaign = load_campaign(args.campaign).with_overrides(
-            n_realizations=args.n, seed=args.seed, aero_model=args.aero_model
-        )
-    except ConfigError as e:
-        print(f"rocketmc: error: {args.campaign}: {e}", file=sys.stderr)
-        return 2
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model)
     if args.scheduler is None and args.workers is None:
         return _fly(args, campaign, run_chunks)
     try:
@@ -32,32 +32,25 @@ def _run(args) -> int:
     except ModuleNotFoundError as e:
         if e.name not in ("dask", "distributed"):
             raise
-        print("rocketmc: error: --workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')",
-              file=sys.stderr)  # fmt: skip
-        return 2
-    try:
-        with dask.cluster(args.scheduler, args.workers) as client:
-            return _fly(args, campaign, functools.partial(dask.run_chunks, client), dask.describe(client))
-    except dask.ClusterError as e:
-        print(f"rocketmc: error: {e}", file=sys.stderr)
-        return 2
+        raise RocketmcError("--workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')") from None
+    with dask.cluster(args.scheduler, args.workers) as client:
+        return _fly(args, campaign, functools.partial(dask.run_chunks, client), dask.describe(client))
 
 
 def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     """Fly ``campaign``'s missing chunks with ``run_chunks`` (``campaign.run_chunks`` or its Dask twin,
     ``where`` describing the cluster) and write the result file."""
     from .analysis.ellipse import AreaConvergence
-    from .campaign import ResultWriter, ResumeError
+    from .campaign import ResultWriter
     from .campaign.runner import chunking
 
     cfg = campaign.config
-    out = Path(args.out or f"{cfg.name}.h5")
+    out = Path(args.out or f"{file_stem(cfg.name)}.h5")
     chunk_size, n_chunks = chunking(campaign, args.chunk_size)
-    try:
-        writer = ResultWriter(out, campaign, chunk_size, resume=args.resume)
-    except ResumeError as e:
-        print(f"rocketmc: error: {e}", file=sys.stderr)
-        return 2
+    writer = ResultWriter(out, campaign, chunk_size, resume=args.resume)
+    if writer.already_complete:
+        print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
+        return 0
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
     tty = sys.stderr.isatty() and not args.quiet
@@ -78,32 +71,34 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
             convergence.add(writer.chunk_outputs(index, ("status", "impact_north_m", "impact_east_m")))
     if todo and not (convergence and convergence.check()):
         runs = run_chunks(campaign, chunk_size, chunks=todo)
-        log(f"compiled in {next(runs):.1f} s")
-        for i, (index, chunk) in enumerate(zip(todo, runs)):
-            writer.write(chunk, index)
-            flown, seconds = flown + len(chunk.outputs["status"]), seconds + chunk.seconds
-            failed += int((chunk.outputs["status"] != 0).sum())
-            left = (len(todo) - i - 1) * seconds / (i + 1)
-            log(f"chunk {index + 1}/{n_chunks}: {flown} flights this run, {flown / seconds:.0f} flights/s, "
-                f"ETA {'≤ ' if convergence else ''}{left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
-            if convergence is not None:
-                convergence.add(chunk.outputs)
-                if convergence.check():
-                    break
-        runs.close()  # a cluster's chunks still in flight are cancelled
-        if tty:
-            print(file=sys.stderr)  # keep the last progress line
+        try:
+            log(f"compiled in {next(runs):.1f} s")
+            for i, (index, chunk) in enumerate(zip(todo, runs)):
+                writer.write(chunk, index)
+                flown, seconds = flown + len(chunk.outputs["status"]), seconds + chunk.seconds
+                failed += int((chunk.outputs["status"] != 0).sum())
+                left = (len(todo) - i - 1) * seconds / (i + 1)
+                log(f"chunk {index + 1}/{n_chunks}: {flown} flights this run, {flown / seconds:.0f} flights/s, "
+                    f"ETA {'≤ ' if convergence else ''}{left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
+                if convergence is not None:
+                    convergence.add(chunk.outputs)
+                    if convergence.check():
+                        break
+        except KeyboardInterrupt:
+            log(f"interrupted: the chunks finished are kept in {writer.dir}; the same command with --resume "
+                "completes the run")  # fmt: skip
+            raise
+        finally:
+            runs.close()  # a cluster's chunks still in flight are cancelled
+            if tty:
+                print(file=sys.stderr)  # keep the last progress line
     n_rows = None
     if convergence is not None:
         n_rows = convergence.n
         state = "converged" if convergence.converged else f"not converged within the {cfg.n_realizations} allowed"
         log(f"{state} at N = {n_rows}: the 95 % ellipse's area is {convergence.area_m2 / 1e6:.4g} km², its 95 % "
             f"bootstrap interval {100 * convergence.width:.2f} % of it wide (target {args.until_converged:g} %)")  # fmt: skip
-    try:
-        writer.finish(n_rows)
-    except ResumeError as e:
-        print(f"rocketmc: error: {e}", file=sys.stderr)
-        return 2
+    writer.finish(n_rows)
     rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
     log(f"wrote {out} ({flown} flights flown in this run{rate})")
     return 0
@@ -113,56 +108,75 @@ def _report(args) -> int:
     from .analysis import format_summary, load_run, plot_impacts, summarize
     from .analysis.export import MAP_SUFFIXES, write_map
 
-    if not Path(args.file).is_file():
-        print(f"rocketmc: error: {args.file}: file not found", file=sys.stderr)
-        return 2
-    for path in args.map or []:
-        if Path(path).suffix.lower() not in MAP_SUFFIXES:
-            print(f"rocketmc: error: --map {path}: expected a .kml or .geojson file name", file=sys.stderr)
-            return 2
-    try:
-        run = load_run(args.file)
-    except (OSError, ValueError) as e:
-        print(f"rocketmc: error: {args.file}: {e}", file=sys.stderr)
-        return 2
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    maps = [_output_file("--map", path, MAP_SUFFIXES) for path in args.map or []]
+    run = load_run(args.file)
     summary = summarize(run)
     print(json.dumps(summary, indent=2, allow_nan=False) if args.json else format_summary(summary))
-    if args.plot:
-        plot_impacts(run, path=args.plot)
-        print(f"wrote {args.plot}", file=sys.stderr)
-    for path in args.map or []:
-        try:
-            print(f"wrote {write_map(run, path)}", file=sys.stderr)
-        except ValueError as e:
-            print(f"rocketmc: error: {e}", file=sys.stderr)
-            return 2
+    if plot:
+        plot_impacts(run, path=plot)
+        print(f"wrote {plot}", file=sys.stderr)
+    for path in maps:
+        print(f"wrote {write_map(run, path)}", file=sys.stderr)
     return 0
+
+
+def _figure_suffixes() -> tuple[str, ...]:
+    """The file suffixes matplotlib writes figures as (.png, .pdf, .svg, ...)."""
+    from matplotlib.figure import Figure
+
+    return tuple(f".{kind}" for kind in Figure().canvas.get_supported_filetypes())
+
+
+def _output_file(option: str, path: str, suffixes: tuple[str, ...]) -> Path:
+    """``path`` given to ``option`` if a file of one of ``suffixes`` can be written there, checked
+    before any work; else a one-line RocketmcError."""
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise RocketmcError(f"{option} {path}: expected a {' or '.join(suffixes)} file name")
+    if path.is_dir():
+        raise RocketmcError(f"{option} {path}: is a folder, expected a file name")
+    folder = path.parent
+    if not folder.is_dir():
+        raise RocketmcError(f"{option} {path}: no folder {folder} to write it in")
+    if not os.access(folder, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise RocketmcError(f"{option} {path}: not writable (read-only folder or file)")
+    return path
+
+
+def _campaign(path, **overrides):
+    """The campaign file ``path`` with the CLI's overrides (N, seed, aerodynamic model); an error
+    names the file."""
+    from .campaign import ConfigError, load_campaign
+
+    try:
+        return load_campaign(path).with_overrides(**overrides)
+    except ConfigError as e:
+        raise RocketmcError(f"{path}: {e}") from None
 
 
 def _rocket_campaign(rocket: str):
     """The campaign file ``rocket``, or a minimal campaign around the preset of that name."""
-    from .campaign import load_campaign, parse_campaign
+    from .campaign import ConfigError, campaign_from_dict
 
     if rocket.endswith(".toml"):
-        return load_campaign(rocket)
-    return parse_campaign(
-        f'name = "{rocket}"\nn_realizations = 1\nseed = 0\n[rocket]\npreset = "{rocket}"\n'
-        "[site]\nlatitude_deg = 0.0\nlongitude_deg = 0.0\naltitude_m = 0.0\n"
-        "[launch]\nrail_length_m = 1.0\nelevation_deg = 90.0\nazimuth_deg = 0.0\n"
-    )
+        return _campaign(rocket)
+    try:
+        return campaign_from_dict({
+            "name": rocket, "n_realizations": 1, "seed": 0, "rocket": {"preset": rocket},
+            "site": {"latitude_deg": 0.0, "longitude_deg": 0.0, "altitude_m": 0.0},
+            "launch": {"rail_length_m": 1.0, "elevation_deg": 90.0, "azimuth_deg": 0.0},
+        })  # fmt: skip
+    except ConfigError as e:
+        raise RocketmcError(f"{rocket}: {e}") from None
 
 
 def _aero_derivatives(args) -> int:
     from .aero.model import LinearAero, linear_derivatives, simplify
-    from .campaign import ConfigError
     from .campaign.model import nominal_params
     from .sim.flight import mass_properties
 
-    try:
-        campaign = _rocket_campaign(args.rocket)
-    except ConfigError as e:
-        print(f"rocketmc: error: {args.rocket}: {e}", file=sys.stderr)
-        return 2
+    campaign = _rocket_campaign(args.rocket)
     params = nominal_params(campaign)
     aero = params.rocket.aero
     linear = aero if isinstance(aero, LinearAero) else simplify(aero)
@@ -207,6 +221,8 @@ def _aero_derivatives(args) -> int:
     return 0
 
 
+MAX_MACH = 10.0
+"""Largest Mach number ``aero derivatives`` evaluates at (tables are clamped at their edge beyond theirs)."""
 FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
 """The real flights ``validate`` knows and their built-in campaigns (data/campaigns)."""
 
@@ -216,19 +232,15 @@ def _validate(args) -> int:
 
     from .analysis.flight_log import load_roccaraso_2021, reduce_flight
     from .analysis.validation import plot_against_log, validate_euroc, validate_roccaraso
-    from .campaign import ConfigError, load_campaign
 
     path = args.campaign or Path(str(resources.files("rocketmc") / "data" / "campaigns" / FLIGHTS[args.flight]))
-    try:
-        campaign = load_campaign(path)
-    except ConfigError as e:
-        print(f"rocketmc: error: {path}: {e}", file=sys.stderr)
-        return 2
+    campaign = _campaign(path)
     if args.flight == "roccaraso-2021":
+        if args.plot:  # before the flight: a folder that cannot be made is said at once
+            Path(args.plot).mkdir(parents=True, exist_ok=True)
         reduction = reduce_flight(load_roccaraso_2021())
         checks, flight = validate_roccaraso(campaign, reduction)
         if args.plot:
-            Path(args.plot).mkdir(parents=True, exist_ok=True)
             plot_against_log(flight, reduction, Path(args.plot) / "roccaraso_2021.png")
     else:
         checks = validate_euroc(campaign)
@@ -256,11 +268,9 @@ def _bench(args) -> int:
         report = run_benchmarks(campaign, tuple(args.sizes), tuple(args.models), tuple(args.precision),
                                 args.chunk_size, log=lambda line: print(line, file=sys.stderr, flush=True))  # fmt: skip
     except ConfigError as e:
-        print(f"rocketmc: error: {campaign}: {e}", file=sys.stderr)
-        return 2
+        raise RocketmcError(f"{campaign}: {e}") from None
     except BenchError as e:
-        print(f"rocketmc: error: {e}", file=sys.stderr)
-        return 1
+        return _fail(str(e), 1)
     print(json.dumps(report, indent=2) if args.json else format_report(report))
     return 0
 
@@ -334,13 +344,35 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if min(getattr(args, "sizes", [1])) < 1:
         parser.error("--n must be at least 1")
-    if getattr(args, "until_converged", None) is not None and not args.until_converged > 0:
-        parser.error("--until-converged must be a positive percentage")
+    if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
+        parser.error("--until-converged must be a percentage in (0, 100]")
     for name in ("n", "chunk_size", "workers"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    return {"run": _run, "report": _report, "aero": _aero_derivatives, "validate": _validate,
-            "bench": _bench}[args.command](args)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    if (getattr(args, "workers", None) or 0) > cores:
+        parser.error(f"--workers must be at most the {cores} core(s) of this machine (one process per core)")
+    if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
+        parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
+                     f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
+    command = {"run": _run, "report": _report, "aero": _aero_derivatives, "validate": _validate, "bench": _bench}
+    try:
+        return command[args.command](args)
+    except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk
+        return _fail(str(e))
+    except BrokenPipeError:  # `rocketmc report FILE | head`: the reader has gone, nothing more to say
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit's flush
+        return 128 + signal.SIGPIPE
+    except OSError as e:  # a file that cannot be read or written
+        return _fail(f"{e.filename}: {e.strerror}" if e.filename else str(e))
+    except KeyboardInterrupt:
+        return _fail("interrupted", 128 + signal.SIGINT)
+
+
+def _fail(message: str, code: int = 2) -> int:
+    """Say ``message`` in one line on stderr; return the exit code."""
+    print(f"rocketmc: error: {' '.join(message.split())}", file=sys.stderr)
+    return code
 
 
 if __name__ == "__main__":

@@ -38,7 +38,7 @@ def test_preset_and_override():
         (edited("n_realizations = 1000\n", ""), "n_realizations", "missing"),
         (edited("seed = 2021", 'seed = "2021"'), "seed", "integer"),
         (edited("rail_length_m = 4.0", "rail_length_m = 4.0\nrail_lenght_m = 5.0"), "launch.rail_lenght_m", "unknown key"),
-        (edited('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = -1.0'), "rocket.dry_mass_kg", "greater than 0"),
+        (edited('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = -1.0'), "rocket.dry_mass_kg", "greater than or equal to 0.001"),
         (edited("elevation_deg = 84.0", "elevation_deg = 95.0"), "launch.elevation_deg", "less than or equal to 90"),
         (edited("speed_mps = 7.5", "speed_mps = -7.5"), "environment.wind.layers.0.speed_mps", "greater than or equal to 0"),
         (edited('preset = "lynx"', 'preset = "lynks"'), "rocket.preset", "unknown preset"),

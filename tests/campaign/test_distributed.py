@@ -1,6 +1,7 @@
 """Runs on Dask (``run --workers N`` / ``--scheduler ADDRESS``): a two-worker local cluster writes the
 bits of a local run, also when resuming, stopping early or losing a worker mid-run; a scheduler that
-cannot be reached, a missing 'dask' extra and bad options are one line and exit code 2."""
+cannot be reached (or a port that never answers, answers garbage or closes at once), a missing 'dask'
+extra and bad options are one line and exit code 2."""
 
 from __future__ import annotations
 
@@ -9,7 +10,9 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
+from contextlib import contextmanager
 
 import dask
 import jax
@@ -19,6 +22,7 @@ import pytest
 import rocketmc.campaign
 from rocketmc.campaign import ResultWriter, load_campaign
 from rocketmc.campaign import distributed as dask_runner
+from rocketmc.campaign.fingerprint import fingerprint, setup
 from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
@@ -98,8 +102,10 @@ def tasks_of_rocketmc(dask_scheduler) -> list:
 
 def refuses_workers_unlike_the_client(client, campaign) -> None:
     """A worker of another rocketmc version refuses the chunk before compiling (exit code 2 in the CLI)."""
-    future = client.submit(dask_runner._fly, campaign, "token", CHUNK, 0, ("0.0.0", jax.__version__, True))
-    with pytest.raises(dask_runner.ClusterError, match="the bits would differ"):
+    client_setup = setup(campaign)
+    client_setup = {**client_setup, "versions": {**client_setup["versions"], "rocketmc": "0.0.0"}}
+    future = client.submit(dask_runner._fly, campaign, client_setup, CHUNK, 0)
+    with pytest.raises(dask_runner.ClusterError, match=r"\(versions.rocketmc\); the bits would differ"):
         future.result()
 
 
@@ -125,22 +131,76 @@ def survives_a_killed_worker(client, campaign, want: dict) -> None:
     assert any(n > 1 for n in flown.values())  # the victim's chunk(s) were flown again
 
 
-def test_the_campaign_digest_is_the_same_in_every_process():
-    # The workers' compiled functions are kept under it, for the next runs of the campaign.
-    code = f"from rocketmc.campaign import load_campaign, distributed; print(distributed.digest(load_campaign({CAMPAIGN!r})))"
-    digest = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
-    assert digest == dask_runner.digest(load_campaign(CAMPAIGN))
+def test_the_set_up_fingerprint_is_the_same_in_every_process():
+    # The compiled chunk functions are kept under it, and resumed runs are checked against it.
+    code = ("from rocketmc.campaign import load_campaign; from rocketmc.campaign.fingerprint import fingerprint, setup; "
+            f"print(fingerprint(setup(load_campaign({CAMPAIGN!r}), 8)))")  # fmt: skip
+    found = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert found == fingerprint(setup(load_campaign(CAMPAIGN), 8))
 
 
-def test_unreachable_scheduler_is_one_line(tmp_path, capsys, monkeypatch):
-    with socket.socket() as s:  # a port nobody listens on
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    monkeypatch.setattr(dask_runner, "CONNECT_TIMEOUT_S", 1.0)  # a refused connection is retried until the timeout
-    assert main(["run", CAMPAIGN, "-n", "8", "--out", str(tmp_path / "run.h5"), "--scheduler", f"tcp://127.0.0.1:{port}"]) == 2
+@contextmanager
+def listening(answer):
+    """The address of a server thread on 127.0.0.1 that hands each connection it accepts to ``answer``
+    (None: nothing listens there); its connections are closed on exit."""
+    if answer is None:
+        with socket.socket() as s:  # a port nobody listens on
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        yield f"tcp://127.0.0.1:{port}"
+        return
+    stop, accepted = threading.Event(), []
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        server.settimeout(0.05)  # to see `stop`
+
+        def serve():
+            while not stop.is_set():
+                try:
+                    connection = server.accept()[0]
+                except TimeoutError:
+                    continue
+                accepted.append(connection)
+                answer(connection)
+
+        thread = threading.Thread(target=serve, daemon=True)
+        thread.start()
+        try:
+            yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        finally:
+            stop.set()
+            thread.join()
+            for connection in accepted:
+                connection.close()
+
+
+@pytest.mark.parametrize(
+    ("answer", "says"),
+    [
+        (None, "no Dask scheduler reachable there"),  # a refused connection is retried until CONNECT_TIMEOUT_S
+        (lambda connection: None, "no answer from a Dask scheduler within 2 s"),  # accepts, then says nothing
+        (lambda connection: connection.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n"),
+         "not a Dask scheduler"),
+        (lambda connection: connection.close(), "the connection was closed without answering as a Dask scheduler"),
+    ],
+    ids=["nothing listens", "never answers", "answers garbage", "closes at once"],
+)  # fmt: skip
+def test_a_port_without_a_scheduler_is_one_line(answer, says, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(dask_runner, "CONNECT_TIMEOUT_S", 1.0)
+    monkeypatch.setattr(dask_runner, "ANSWER_MARGIN_S", 1.0)  # a 2 s deadline
+    threads = set(threading.enumerate())
+    with listening(answer) as address:
+        t0 = time.monotonic()
+        assert main(["run", CAMPAIGN, "-n", "4", "--scheduler", address, "--out", str(tmp_path / "r.h5")]) == 2
+        # The 2 s deadline, then closing the client and loading the campaign (< 1 s each), with room for a
+        # loaded machine; the port that never answers held the client forever before.
+        assert time.monotonic() - t0 < 2.0 + 5.0
     err = capsys.readouterr().err
-    assert err.startswith(f"rocketmc: error: --scheduler tcp://127.0.0.1:{port}: no Dask scheduler") and err.count("\n") == 1
-    assert not list(tmp_path.iterdir())  # no partial run left to resume
+    assert err.startswith(f"rocketmc: error: --scheduler {address}: {says}") and err.count("\n") == 1
+    assert not list(tmp_path.iterdir())  # no result file or partial run left to resume
+    # Nothing left to keep the CLI's process alive (distributed's idle event loop thread is a daemon).
+    assert [thread for thread in threading.enumerate() if thread not in threads and not thread.daemon] == []
 
 
 def test_missing_extra_and_bad_options(tmp_path, capsys, monkeypatch):

@@ -190,7 +190,7 @@ def load_aero_tables(path) -> AeroTables:
             return _read_tables(file, path)
     except AeroFileError:
         raise
-    except OSError as err:
+    except (OSError, RuntimeError, KeyError) as err:  # h5py's errors on damaged files
         raise AeroFileError(f"{path}: not a readable HDF5 file ({err})") from None
     except (ValueError, TypeError) as err:  # the tables' own validation
         raise AeroFileError(f"{path}: {err}") from None
@@ -252,7 +252,10 @@ def read_aero_csv(
     the ``#`` header; other ``#`` lines at the top are free comments.
     """
     path = _existing(path)
-    header, n_comment_lines = _csv_header(path)
+    try:
+        header, n_comment_lines = _csv_header(path)
+    except UnicodeDecodeError:
+        raise AeroFileError(f"{path}: not a UTF-8 text file") from None
     overrides = dict(zip(REFERENCE_KEYS, (reference_area_m2, reference_length_m, moment_reference_m)))
     reference = [_csv_reference(path, header, key, overrides[key]) for key in REFERENCE_KEYS]
     try:

@@ -11,6 +11,7 @@ from xml.etree import ElementTree
 import numpy as np
 
 from ..env.site import latitude_longitude_deg
+from ..files import replacing
 from .ellipse import confidence_ellipse
 from .results import SUMMARY_LEVELS, Run
 
@@ -115,5 +116,6 @@ def write_map(run: Run, path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in MAP_SUFFIXES:
         raise ValueError(f"{path}: expected a .kml or .geojson file name")
-    path.write_text(to_kml(run) if path.suffix.lower() == ".kml" else json.dumps(to_geojson(run), indent=1))
+    with replacing(path) as partial:
+        partial.write_text(to_kml(run) if path.suffix.lower() == ".kml" else json.dumps(to_geojson(run), indent=1))
     return path

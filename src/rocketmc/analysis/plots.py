@@ -8,6 +8,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from ..files import replacing
 from .ellipse import confidence_ellipse
 from .results import Run
 
@@ -72,5 +73,6 @@ def plot_impacts(
     for handle in legend.legend_handles:  # faint scatter points stay visible in the legend
         handle.set_alpha(1.0)
     if path is not None:
-        fig.savefig(path, dpi=150)
+        with replacing(path) as partial:  # a full disk leaves no half-written figure
+            fig.savefig(partial, dpi=150, format=Path(path).suffix.lstrip(".").lower() or "png")
     return fig

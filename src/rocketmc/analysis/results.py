@@ -18,12 +18,19 @@ import h5py
 import numpy as np
 import pandas as pd
 
+from ..errors import RocketmcError
 from .ellipse import bootstrap_intervals, confidence_ellipse
 
 SUMMARY_LEVELS = (0.5, 0.95, 0.99)
 """Confidence levels of the impact ellipses in :func:`summarize`."""
 
 _PERCENTILES = {"p5": 5.0, "p50": 50.0, "p95": 95.0}
+REQUIRED_OUTPUTS = ("status", "impact_north_m", "impact_east_m")
+"""Datasets every result file has (docs/conventions.md) and the report reads."""
+
+
+class ResultFileError(RocketmcError, ValueError):
+    """A file that is not a complete rocketmc result file; one line naming it."""
 
 
 @dataclass(frozen=True)
@@ -41,7 +48,7 @@ class Run:
     def ok(self) -> np.ndarray:
         """Boolean mask of realizations with status 0."""
         if "status" not in self.outputs:
-            raise ValueError("result file has no /outputs/status dataset")
+            raise ResultFileError("result file has no /outputs/status dataset")
         return self.outputs["status"].to_numpy() == 0
 
     def ok_impacts(self) -> tuple[np.ndarray, np.ndarray]:
@@ -63,12 +70,26 @@ def _native(value):
     return value
 
 
-def _checked(f: h5py.File, path) -> None:
-    """Raise ValueError unless ``f`` is a complete rocketmc result file."""
-    if not isinstance(f.get("outputs"), h5py.Group):
-        raise ValueError(f"{path}: not a rocketmc result file (no /outputs group)")
-    if not bool(f.attrs.get("complete", False)):
-        raise ValueError(f"{path}: result file is incomplete (run still in progress or aborted)")
+def _open(path) -> h5py.File:
+    """The result file ``path``, open to read; ResultFileError unless it is a complete one."""
+    try:
+        f = h5py.File(path, "r")
+    except FileNotFoundError:
+        raise ResultFileError(f"{path}: file not found") from None
+    except OSError as e:
+        raise ResultFileError(f"{path}: not an HDF5 file, or damaged ({str(e).splitlines()[0]})") from None
+    try:
+        if not isinstance(f.get("outputs"), h5py.Group):
+            raise ResultFileError(f"{path}: not a rocketmc result file (no /outputs group)")
+        if not bool(f.attrs.get("complete", False)):
+            raise ResultFileError(f"{path}: result file is incomplete (run still in progress or aborted)")
+        missing = [name for name in REQUIRED_OUTPUTS if not isinstance(f["outputs"].get(name), h5py.Dataset)]
+        if missing:
+            raise ResultFileError(f"{path}: not a rocketmc result file (no {', '.join('/outputs/' + m for m in missing)})")
+    except BaseException:
+        f.close()
+        raise
+    return f
 
 
 def _read_group(f: h5py.File, name: str, path) -> tuple[pd.DataFrame, dict[str, str]]:
@@ -80,48 +101,47 @@ def _read_group(f: h5py.File, name: str, path) -> tuple[pd.DataFrame, dict[str, 
     for key, item in group.items():
         if not isinstance(item, h5py.Dataset):
             continue
-        if item.ndim != 1:
-            raise ValueError(f"{path}: /{name}/{key} is not 1-D (shape {item.shape})")
+        if item.ndim != 1 or not np.issubdtype(item.dtype, np.number):
+            raise ResultFileError(f"{path}: /{name}/{key} is not a 1-D array of numbers ({item.shape}, {item.dtype})")
         columns[key] = item[()]
         if "unit" in item.attrs:
             units[key] = _native(item.attrs["unit"])
     lengths = {len(v) for v in columns.values()}
     if len(lengths) > 1:
-        raise ValueError(f"{path}: datasets in /{name} differ in length: {sorted(lengths)}")
+        raise ResultFileError(f"{path}: datasets in /{name} differ in length: {sorted(lengths)}")
     n = lengths.pop() if lengths else 0
     return pd.DataFrame(columns, index=pd.RangeIndex(n, name="realization")), units
 
 
 def load_outputs(path: str | Path) -> pd.DataFrame:
     """Per-realization outputs of a complete result file (one column per ``/outputs`` dataset)."""
-    with h5py.File(path, "r") as f:
-        _checked(f, path)
+    with _open(path) as f:
         return _read_group(f, "outputs", path)[0]
 
 
 def load_inputs(path: str | Path) -> pd.DataFrame:
     """Per-realization sampled dispersions of a complete result file (``/inputs`` datasets)."""
-    with h5py.File(path, "r") as f:
-        _checked(f, path)
+    with _open(path) as f:
         return _read_group(f, "inputs", path)[0]
 
 
 def load_run(path: str | Path) -> Run:
     """Outputs, inputs, root attributes, units and status codes of a complete result file."""
-    with h5py.File(path, "r") as f:
-        _checked(f, path)
+    with _open(path) as f:
         outputs, units = _read_group(f, "outputs", path)
         inputs, input_units = _read_group(f, "inputs", path)
         attrs = {k: _native(v) for k, v in f.attrs.items()}
         codes = {}
         if "status" in f["outputs"] and "codes" in f["outputs/status"].attrs:
-            raw = json.loads(_native(f["outputs/status"].attrs["codes"]))
-            codes = {int(k): str(v) for k, v in raw.items()}
+            try:
+                codes = {int(k): str(v) for k, v in json.loads(_native(f["outputs/status"].attrs["codes"])).items()}
+            except (ValueError, AttributeError):
+                raise ResultFileError(f"{path}: /outputs/status's codes attribute is not a JSON object of codes") from None
     expected = attrs.get("n_realizations")
     if expected is not None and len(outputs) != expected:
-        raise ValueError(f"{path}: {len(outputs)} output rows but n_realizations = {expected}")
+        raise ResultFileError(f"{path}: {len(outputs)} output rows but n_realizations = {expected}")
     if len(inputs.columns) and len(inputs) != len(outputs):
-        raise ValueError(f"{path}: {len(inputs)} input rows but {len(outputs)} output rows")
+        raise ResultFileError(f"{path}: {len(inputs)} input rows but {len(outputs)} output rows")
     return Run(outputs, inputs, attrs, {**input_units, **units}, codes)
 
 

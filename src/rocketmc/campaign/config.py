@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import hashlib
 import tomllib
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry
 from ..aero.io import load_aero
@@ -23,7 +24,8 @@ from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_incre
 from ..aero.tables import AeroTables
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
-from ..env.wind import read_wind_profile
+from ..errors import RocketmcError
+from ..env.wind import POWER_LAW_FLOOR_M, read_wind_profile
 from ..math.table import Table
 
 DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
@@ -33,36 +35,83 @@ dispersible, except those of ``DISPERSIBLE_AERO``."""
 DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.linear.")
 ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
 
+# Physical ranges (docs/conventions.md, Campaign validation): every number is finite and within these, generous
+# for any student or amateur rocket, so that a typo or a unit slip is refused here instead of flying a campaign
+# of failed flights.
+MIN_MASS_KG = 1e-3  # 1 g, below any model rocket: the mass divides every force
+MAX_MASS_KG = 5000.0  # a few tonnes: the heaviest amateur rockets weigh under 2 t
+MIN_LENGTH_M = 1e-4  # 0.1 mm, thinner than any fin
+MAX_LENGTH_M = 100.0  # lengths and positions: amateur rockets are under 20 m long
+MAX_DIAMETER_M = 10.0  # diameters: amateur rockets are under 1 m across
+MAX_AREA_M2 = 1000.0  # canopy and reference areas: the largest cargo canopies have ~700 m²
+MIN_INERTIA_KGM2 = 1e-9  # a 1 g rod 5 mm across has an axial inertia of 3·10⁻⁹ kg·m²; it divides every moment
+MAX_INERTIA_KGM2 = 1e7  # a 5 t, 100 m rod about its middle has m·L²/12 ≈ 4·10⁶ kg·m²
+MAX_ISP_S = 500.0  # above any chemical motor (hydrogen-oxygen in vacuum: ~450 s)
+MAX_SCALE = 10.0  # multipliers of a measured curve (thrust, drag, wind): ×10 is a unit slip, not a dispersion
+MAX_DELAY_S = 60.0  # ignition delay, parachute delay and opening time: longer is a flight without that event
+MAX_FLIGHT_TIME_S = 3600.0  # a descent under a main canopy from 10 km takes under ~2000 s
+MAX_ALTITUDE_M = 100_000.0  # heights above ground: the standard atmosphere ends at 47 km (status 4 above)
+MAX_WIND_MPS = 150.0  # above the strongest jet-stream winds measured (~110 m/s)
+MAX_MACH = 25.0  # Mach axes: beyond any sounding rocket
+MAX_DRAG_COEFFICIENT = 10.0  # axial-force and canopy coefficients: a flat plate's is 1.2, a canopy's 0.8-2.2
+MAX_COEFFICIENT = 1000.0  # static derivatives and offsets [per rad]: 40 × Lynx's CNα (24 per rad)
+MAX_DAMPING_COEFFICIENT = 1e5  # damping derivatives [per ω·d/(2V)]: 50 × Lynx's Cmq (−1813)
+MIN_CONTROL_DT_S = 1e-3  # 1 kHz, the fastest flight-computer loops; a flight is max_time_s/control_dt_s periods
+MAX_REALIZATIONS = 10**8  # ~20 float64 outputs per flight: 10⁸ flights fill ~16 GB
+MAX_NAME_LENGTH = 128  # a campaign's name is a label, printed and stored in result files
+NORMAL_REACH_STD = 6.0
+"""An unclipped side of a normal dispersion is checked at mean ± 6·std: a draw beyond has a
+probability of ~1e-9."""
 
-class ConfigError(ValueError):
+
+class ConfigError(RocketmcError, ValueError):
     """A campaign that cannot be flown; the message is one line naming the field."""
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
 
-Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
+Mass = Annotated[float, Field(ge=MIN_MASS_KG, le=MAX_MASS_KG)]
+Position = Annotated[float, Field(ge=-MAX_LENGTH_M, le=MAX_LENGTH_M, description="in the rocket's coordinates [m]")]
+Length = Annotated[float, Field(ge=MIN_LENGTH_M, le=MAX_LENGTH_M)]
+Diameter = Annotated[float, Field(ge=MIN_LENGTH_M, le=MAX_DIAMETER_M)]
+Area = Annotated[float, Field(gt=0, le=MAX_AREA_M2)]
+Inertia = Annotated[float, Field(ge=MIN_INERTIA_KGM2, le=MAX_INERTIA_KGM2)]
+Scale = Annotated[float, Field(gt=0, le=MAX_SCALE)]
+Delay = Annotated[float, Field(ge=0, le=MAX_DELAY_S)]
+Height = Annotated[float, Field(gt=0, le=MAX_ALTITUDE_M)]
+WindSpeed = Annotated[float, Field(ge=0, le=MAX_WIND_MPS)]
+Direction = Annotated[float, Field(ge=-360, le=720, description="[deg], clockwise; −360 to 720 accepted")]
+Mach = Annotated[float, Field(ge=0, le=MAX_MACH)]
+DragCoefficient = Annotated[float, Field(ge=0, le=MAX_DRAG_COEFFICIENT)]
+Coefficient = Annotated[float, Field(ge=-MAX_COEFFICIENT, le=MAX_COEFFICIENT)]
+DampingCoefficient = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=MAX_DAMPING_COEFFICIENT)]
+Damping = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=0)]
 
 
 class MotorConfig(_Strict):
     """Solid motor; positions in the rocket's coordinates [m]."""
 
     thrust_curve: str = Field(description="RASP .eng or CSV (time s, thrust N); built-in name or path")
-    propellant_mass_kg: Positive
-    isp_s: Positive | None = Field(None, description="checked against the curve's impulse / propellant")
-    ignition_delay_s: NonNegative = 0.0
-    thrust_scale: Positive = 1.0
-    nozzle_m: float
-    grain_outer_diameter_m: Positive
-    grain_inner_diameter_m: NonNegative
-    grain_length_m: Positive
-    grain_center_m: float | None = Field(None, description="default: the grain ends at the nozzle exit")
-    dry_mass_kg: NonNegative = Field(0.0, description="casing, nozzle, closures: 0 if the rocket's dry mass has them")
-    dry_inertia_kgm2: list[NonNegative] = Field([0.0, 0.0], min_length=2, max_length=2,
-                                                description="[axial, transverse] about the motor's dry CG")
-    dry_cg_m: float | None = Field(None, description="default: the grain centre")
+    propellant_mass_kg: Mass
+    isp_s: float | None = Field(
+        None, gt=0, le=MAX_ISP_S, description="checked against the curve's impulse / propellant"
+    )
+    ignition_delay_s: Delay = 0.0
+    thrust_scale: Scale = 1.0
+    nozzle_m: Position
+    grain_outer_diameter_m: Diameter
+    grain_inner_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M)
+    grain_length_m: Length
+    grain_center_m: Position | None = Field(None, description="default: the grain ends at the nozzle exit")
+    dry_mass_kg: float = Field(0.0, ge=0, le=MAX_MASS_KG,
+                               description="casing, nozzle, closures: 0 if the rocket's dry mass has them")
+    dry_inertia_kgm2: list[Annotated[float, Field(ge=0, le=MAX_INERTIA_KGM2)]] = Field(
+        [0.0, 0.0], min_length=2, max_length=2, description="[axial, transverse] about the motor's dry CG"
+    )
+    dry_cg_m: Position | None = Field(None, description="default: the grain centre")
 
     @model_validator(mode="after")
     def _core_inside_grain(self):
@@ -83,20 +132,20 @@ class LinearCoefficientsConfig(_Strict):
     u = (yaw, pitch, roll, squeeze) as in the thesis (aero/model.py, ``from_virtual_commands``);
     damping per ω·d/(2V)."""
 
-    reference_area_m2: Positive
-    reference_length_m: Positive
-    ca0_mach: list[NonNegative] = Field(min_length=2)
-    ca0: list[NonNegative] = Field(min_length=2)
-    ca_u: list[float] = Field([0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4)
-    cn_alpha: float
-    cn_delta: float = 0.0
-    cm_alpha: float
-    cm_delta: float = 0.0
-    cl_delta: float = 0.0
-    cy_r: float = 0.0
-    cn_q: float = 0.0
-    cl_p: float = Field(0.0, le=0)
-    cm_q: float = Field(0.0, le=0)
+    reference_area_m2: Area
+    reference_length_m: Length
+    ca0_mach: list[Mach] = Field(min_length=2)
+    ca0: list[DragCoefficient] = Field(min_length=2)
+    ca_u: list[Coefficient] = Field([0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4)
+    cn_alpha: Coefficient
+    cn_delta: Coefficient = 0.0
+    cm_alpha: Coefficient
+    cm_delta: Coefficient = 0.0
+    cl_delta: Coefficient = 0.0
+    cy_r: DampingCoefficient = 0.0
+    cn_q: DampingCoefficient = 0.0
+    cl_p: Damping = 0.0
+    cm_q: Damping = 0.0
 
     @model_validator(mode="after")
     def _mach_table(self):
@@ -116,14 +165,14 @@ class AeroConfig(_Strict):
         "buildup",
         description="'buildup' (from [rocket.geometry]), a built-in table name, or a .h5/.csv/.mat file",
     )
-    reference_area_m2: Positive | None = Field(None, description="for table files that do not state it")
-    reference_length_m: Positive | None = None
-    moment_reference_m: float | None = Field(None, description="in the rocket's coordinates; for files that do not state it")
-    cd_mach: list[NonNegative] | None = Field(None, description="Cd-vs-Mach curve replacing the zero-lift axial force")
-    cd: list[NonNegative] | None = None
-    cd_power_on: list[NonNegative] | None = Field(None, description="Cd at cd_mach while the motor burns")
-    drag_scale: Positive = 1.0
-    cl0: float = Field(0.0, description="rolling-moment offset (fin misalignment)")
+    reference_area_m2: Area | None = Field(None, description="for table files that do not state it")
+    reference_length_m: Length | None = None
+    moment_reference_m: Position | None = Field(None, description="for table files that do not state it")
+    cd_mach: list[Mach] | None = Field(None, description="Cd-vs-Mach curve replacing the zero-lift axial force")
+    cd: list[DragCoefficient] | None = None
+    cd_power_on: list[DragCoefficient] | None = Field(None, description="Cd at cd_mach while the motor burns")
+    drag_scale: Scale = 1.0
+    cl0: Coefficient = Field(0.0, description="rolling-moment offset (fin misalignment)")
     linear: LinearCoefficientsConfig | None = None
 
     @model_validator(mode="after")
@@ -141,38 +190,45 @@ class AeroConfig(_Strict):
 
 class NoseConfig(_Strict):
     kind: Literal[NOSE_KINDS]
-    length_m: Positive
+    length_m: Length
 
 
 class FinSetConfig(_Strict):
     """Trapezoidal panels (aero/geometry.py ``FinSet``); position_m: the root's leading edge."""
 
     count: int = Field(ge=1, le=8)
-    root_chord_m: Positive
-    tip_chord_m: NonNegative
-    span_m: Positive
-    sweep_m: float = 0.0
-    position_m: float
-    thickness_m: Positive = 0.005
+    root_chord_m: Length
+    tip_chord_m: float = Field(ge=0, le=MAX_LENGTH_M)
+    span_m: Length
+    sweep_m: Position = 0.0
+    position_m: Position
+    thickness_m: Length = 0.005
     cant_deg: float = Field(0.0, ge=-15, le=15)
-    first_panel_deg: float = 0.0
+    first_panel_deg: Direction = 0.0
 
 
 class BoatTailConfig(_Strict):
-    length_m: Positive
-    aft_diameter_m: Positive
-    position_m: float
+    length_m: Length
+    aft_diameter_m: Diameter
+    position_m: Position
 
 
 class GeometryConfig(_Strict):
     """External shape for the aerodynamic build-up; positions in the rocket's coordinates [m]."""
 
-    body_diameter_m: Positive
-    length_m: Positive
+    body_diameter_m: Diameter
+    length_m: Length
     nose: NoseConfig
     fins: list[FinSetConfig] = []
     canards: FinSetConfig | None = None
     boat_tail: BoatTailConfig | None = None
+
+    @model_validator(mode="after")
+    def _nose_on_the_body(self):
+        if self.nose.length_m > self.length_m:
+            raise ValueError(f"nose.length_m ({self.nose.length_m}) exceeds length_m ({self.length_m}), "
+                             "the length from the nose tip to the aft end")  # fmt: skip
+        return self
 
     def to_geometry(self, from_nose=lambda position_m: position_m) -> RocketGeometry:
         """The ``RocketGeometry``; ``from_nose`` maps a position to the distance from the nose tip."""
@@ -195,20 +251,20 @@ class ParachuteConfig(_Strict):
     """A canopy: opens at apogee, or at deploy_altitude_m above ground after apogee."""
 
     name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
-    cd: Positive
-    area_m2: Positive
-    deploy_altitude_m: NonNegative | None = None
-    delay_s: NonNegative = 0.0
-    opening_time_s: NonNegative = 0.0
-    attach_m: float
+    cd: float = Field(gt=0, le=MAX_DRAG_COEFFICIENT)
+    area_m2: Area
+    deploy_altitude_m: float | None = Field(None, ge=0, le=MAX_ALTITUDE_M)
+    delay_s: Delay = 0.0
+    opening_time_s: Delay = 0.0
+    attach_m: Position
 
 
 class AirbrakesConfig(_Strict):
     """Extra axial-force coefficient ΔCA (on the aerodynamic reference area) of deployed airbrakes as a
     schedule of time since motor ignition [s], linear in between, 0 outside."""
 
-    time_s: list[float] = Field(min_length=2)
-    delta_ca: list[NonNegative] = Field(min_length=2)
+    time_s: list[Annotated[float, Field(ge=0, le=MAX_FLIGHT_TIME_S)]] = Field(min_length=2)
+    delta_ca: list[DragCoefficient] = Field(min_length=2)
 
     @model_validator(mode="after")
     def _schedule(self):
@@ -225,13 +281,13 @@ class RocketConfig(_Strict):
     from an origin of the user's choice where the nose tip is at ``nose_position_m``."""
 
     coordinate_system: Literal["nose_to_tail", "tail_to_nose"] = "nose_to_tail"
-    nose_position_m: float = 0.0
-    reference_point_m: float = Field(description="origin of the body frame and, by default, the moment reference")
-    dry_mass_kg: Positive
-    dry_cg_m: float
-    dry_inertia_kgm2: list[Positive] = Field(min_length=2, max_length=2, description="[axial, transverse]")
-    rear_lug_m: float
-    canopy_roll_damping: float = Field(-5.0, le=0)
+    nose_position_m: Position = 0.0
+    reference_point_m: Position = Field(description="origin of the body frame and, by default, the moment reference")
+    dry_mass_kg: Mass
+    dry_cg_m: Position
+    dry_inertia_kgm2: list[Inertia] = Field(min_length=2, max_length=2, description="[axial, transverse]")
+    rear_lug_m: Position
+    canopy_roll_damping: Damping = -5.0
     motor: MotorConfig
     aero: AeroConfig = AeroConfig()
     geometry: GeometryConfig | None = None
@@ -265,15 +321,15 @@ class SiteConfig(_Strict):
 
 
 class LaunchConfig(_Strict):
-    rail_length_m: Positive
+    rail_length_m: Length
     elevation_deg: float = Field(gt=0, le=90, description="rail angle above the horizon")
-    azimuth_deg: float = Field(ge=-360, le=720, description="clockwise from north")
+    azimuth_deg: Direction = Field(description="clockwise from north")
 
 
 class WindLayerConfig(_Strict):
-    speed_mps: NonNegative
-    from_deg: float = Field(ge=-360, le=720, description="direction the wind blows from, clockwise from north")
-    thickness_m: Positive | None = Field(None, description="not needed for the top layer")
+    speed_mps: WindSpeed
+    from_deg: Direction = Field(description="direction the wind blows from, clockwise from north")
+    thickness_m: Height | None = Field(None, description="not needed for the top layer")
 
 
 WIND_MODEL_FIELDS = {
@@ -294,12 +350,14 @@ class WindConfig(_Strict):
 
     model: Literal["layers", "constant", "power_law", "profile"] = "layers"
     layers: list[WindLayerConfig] | None = Field(None, min_length=1)
-    speed_mps: NonNegative | None = Field(None, description="constant wind, or power law at reference_height_m")
-    from_deg: float | None = Field(None, ge=-360, le=720, description="direction the wind blows from")
-    reference_height_m: Positive | None = None
+    speed_mps: WindSpeed | None = Field(None, description="constant wind, or power law at reference_height_m")
+    from_deg: Direction | None = Field(None, description="direction the wind blows from")
+    reference_height_m: float | None = Field(
+        None, ge=POWER_LAW_FLOOR_M, le=MAX_ALTITUDE_M, description="not below the height the law is held at"
+    )
     exponent: float | None = Field(None, ge=0, le=1, description="power-law exponent (1/7 over open terrain)")
     file: str | None = Field(None, description="CSV: altitude_agl_m (or altitude_msl_m), speed_mps, from_deg")
-    speed_scale: NonNegative | None = None
+    speed_scale: float | None = Field(None, ge=0, le=MAX_SCALE)
 
     @model_validator(mode="before")
     @classmethod
@@ -332,7 +390,7 @@ class TurbulenceConfig(_Strict):
     by default 15/30/45 kt from the severity."""
 
     severity: float = Field(ge=0, le=3)
-    w20_mps: NonNegative | None = None
+    w20_mps: WindSpeed | None = None
 
 
 class EnvironmentConfig(_Strict):
@@ -371,20 +429,20 @@ class Dispersion(_Strict):
 
 
 class SimulationConfig(_Strict):
-    control_dt_s: float = Field(0.02, gt=0, le=0.1, description="GNC period")
+    control_dt_s: float = Field(0.02, ge=MIN_CONTROL_DT_S, le=0.1, description="GNC period")
     substeps: int = Field(1, ge=1, le=100, description="RK4 steps per control period")
     descent_dt_s: float = Field(0.25, gt=0, le=1.0, description="longest period in steady descent under canopy")
     descent_h_omega: float = Field(
         1.0, gt=0, le=2.0, description="largest RK4 step times the body's pendulum rate under canopy (RK4 is stable to 2.8)"
     )
-    max_time_s: Positive = 300.0
-    chunk_size: int = Field(1000, ge=1, description="realizations per compiled batch")
+    max_time_s: float = Field(300.0, gt=0, le=MAX_FLIGHT_TIME_S, description="a flight still up by then stops")
+    chunk_size: int = Field(1000, ge=1, le=MAX_REALIZATIONS, description="realizations per compiled batch")
 
 
 class CampaignConfig(_Strict):
-    name: str
+    name: str = Field(description=f"a label of 1 to {MAX_NAME_LENGTH} printable characters on one line")
     description: str = ""
-    n_realizations: int = Field(ge=1)
+    n_realizations: int = Field(ge=1, le=MAX_REALIZATIONS)
     seed: int = Field(ge=0, lt=2**32)
     rocket: RocketConfig
     site: SiteConfig
@@ -392,6 +450,13 @@ class CampaignConfig(_Strict):
     environment: EnvironmentConfig = EnvironmentConfig()
     dispersions: dict[str, Dispersion] = {}
     simulation: SimulationConfig = SimulationConfig()
+
+    @field_validator("name")
+    @classmethod
+    def _label(cls, name: str) -> str:
+        if not (name.strip() and len(name) <= MAX_NAME_LENGTH and name.isprintable()):
+            raise ValueError(f"expected a label: 1 to {MAX_NAME_LENGTH} printable characters on one line, not blank")
+        return name
 
 
 @dataclasses.dataclass(frozen=True)
@@ -410,6 +475,7 @@ class Campaign:
     aero: TableAero | LinearAero | None
     base_dir: Path
     wind_profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    files: dict[str, str] = dataclasses.field(default_factory=dict)
 
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None
@@ -421,7 +487,17 @@ class Campaign:
             return dataclasses.replace(self, config=_validate(data))
         data["rocket"]["aero"]["model"] = aero_model
         config = _validate(data)
-        return dataclasses.replace(self, config=config, aero=_aero_model(config.rocket, self.base_dir))
+        return dataclasses.replace(self, config=config, aero=_aero_model(config.rocket, self.base_dir),
+                                   files=_file_digests(config, self.base_dir))  # fmt: skip
+
+
+SHOWN_INPUT_LENGTH = 60
+"""Characters of a refused value that an error message shows (a 10 000-character name is not repeated)."""
+
+
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= SHOWN_INPUT_LENGTH else f"{text[:SHOWN_INPUT_LENGTH]}... ({len(text)} characters)"
 
 
 def _format_error(error: ValidationError) -> str:
@@ -433,7 +509,7 @@ def _format_error(error: ValidationError) -> str:
         return f"{path}: missing (required)"
     message = first["msg"].removeprefix("Value error, ")
     found = first.get("input")
-    shown = "" if isinstance(found, dict | list) else f" (got {found!r})"
+    shown = "" if isinstance(found, dict | list) else f" (got {_shown(found)})"
     return f"{path}: {message}{shown}"
 
 
@@ -456,22 +532,28 @@ def _deep_merge(base: dict, override: dict) -> dict:
 
 def preset_rocket(name: str) -> dict:
     """The rocket table of a built-in preset (``data/rockets/<name>.toml``)."""
-    resource = resources.files("rocketmc") / "data" / "rockets" / f"{name}.toml"
-    if not resource.is_file():
-        available = sorted(p.name.removesuffix(".toml") for p in resource.parent.iterdir())
-        raise ConfigError(f"rocket.preset: unknown preset {name!r} (available: {', '.join(available)})")
-    return tomllib.loads(resource.read_text())
+    folder = resources.files("rocketmc") / "data" / "rockets"
+    available = sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml"))
+    if name not in available:  # a name, not a path
+        raise ConfigError(f"rocket.preset: unknown preset {_shown(name)} (available: {', '.join(available)})")
+    return tomllib.loads((folder / f"{name}.toml").read_text())
 
 
 def _resolve_data_file(name: str, base_dir: Path, folder: str, field: str) -> Path:
     """``name`` beside the campaign, else in the package's ``data/<folder>``."""
     candidate = base_dir / name
-    if candidate.is_file():
-        return candidate
     builtin = resources.files("rocketmc") / "data" / folder / name
-    if builtin.is_file():
-        return Path(str(builtin))
-    raise ConfigError(f"{field}: file not found: {name!r} (neither beside the campaign nor built in)")
+    try:
+        if candidate.is_file():
+            return candidate
+        if builtin.is_file():
+            return Path(str(builtin))
+        exists = candidate.exists()
+    except OSError as err:  # e.g. a name too long for the file system
+        raise ConfigError(f"{field}: cannot look up {_shown(name)} ({err.strerror})") from None
+    if exists:
+        raise ConfigError(f"{field}: {_shown(name)} is not a file (a folder?)")
+    raise ConfigError(f"{field}: file not found: {_shown(name)} (neither beside the campaign nor built in)")
 
 
 def flatten_numbers(tree, prefix: str = "") -> dict[str, float]:
@@ -498,6 +580,25 @@ def _set_path(data: dict, path: str, value: float) -> dict:
     return data
 
 
+def _drawable_values(d: Dispersion, nominal_value: float, field: str) -> list[tuple[float, str]]:
+    """The values that bound what ``d`` draws (every valid range is an interval, so they are enough), each
+    with a hint for the error message. ConfigError if a normal's clip range excludes its mean."""
+    if d.dist == "choice":
+        return [(value, "") for value in d.values]
+    if d.dist == "uniform":
+        return [(d.low, ""), (d.high, "")]
+    mean = nominal_value if d.mean is None else d.mean
+    if not ((d.low is None or d.low <= mean) and (d.high is None or mean <= d.high)):
+        of = " (the nominal value, as no mean is given)" if d.mean is None else ""
+        raise ConfigError(f"{field}: the clip range [{d.low}, {d.high}] excludes the mean {mean!r}{of}")
+    reach = NORMAL_REACH_STD * d.std
+    sides = [(d.low, mean - reach, "−", "low"), (d.high, mean + reach, "+", "high")]
+    return [(mean, "")] + [
+        (clip, "") if clip is not None else (unclipped, f" (mean {sign} {NORMAL_REACH_STD:g}·std; clip it with {key})")
+        for clip, unclipped, sign, key in sides
+    ]
+
+
 def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> None:
     """Each dispersion names a dispersible number and every value it can draw passes validation."""
     data = config.model_dump(exclude={"dispersions"})
@@ -509,13 +610,12 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
         if path not in nominal:
             raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
                               f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
-        for value in [d.mean, d.low, d.high, *(d.values or [])]:
-            if value is None:
-                continue
+        for value, hint in _drawable_values(d, nominal[path], field):
             try:
                 CampaignConfig.model_validate(_set_path(data, path, value))
             except ValidationError as e:
-                raise ConfigError(f"{field}: draws a value {value!r} that is out of range: {_format_error(e)}") from None
+                raise ConfigError(f"{field}: draws a value {value!r}{hint} that is out of range: "
+                                  f"{_format_error(e)}") from None  # fmt: skip
 
 
 def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
@@ -555,7 +655,22 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
     nominal = {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
     _check_dispersions(config, nominal)
     aero = _aero_model(config.rocket, base_dir)
-    return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, _wind_profile(config, base_dir))
+    return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, _wind_profile(config, base_dir),
+                    _file_digests(config, base_dir))  # fmt: skip
+
+
+def _file_digests(config: CampaignConfig, base_dir: Path) -> dict[str, str]:
+    """SHA-256 of each file the campaign reads, by the field naming it (built-in files too)."""
+    named = {"rocket.motor.thrust_curve": (config.rocket.motor.thrust_curve, "motors")}
+    aero, wind = config.rocket.aero, config.environment.wind
+    if aero.model != "linear" and aero.tables != "buildup" and aero.tables not in BUILTIN_TABLES:
+        named["rocket.aero.tables"] = (aero.tables, "aero")
+    if wind.model == "profile":
+        named["environment.wind.file"] = (wind.file, "wind")
+    return {
+        field: hashlib.sha256(_resolve_data_file(name, base_dir, folder, field).read_bytes()).hexdigest()
+        for field, (name, folder) in named.items()
+    }
 
 
 def _wind_profile(config: CampaignConfig, base_dir: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -564,9 +679,13 @@ def _wind_profile(config: CampaignConfig, base_dir: Path) -> tuple[np.ndarray, n
         return None
     path = _resolve_data_file(wind.file, base_dir, "wind", "environment.wind.file")
     try:
-        return read_wind_profile(path, config.site.altitude_m)
+        altitude, speed, from_rad = read_wind_profile(path, config.site.altitude_m)
     except (ValueError, OSError) as err:
         raise ConfigError(f"environment.wind.file: {err}") from None
+    if speed.max() > MAX_WIND_MPS:
+        raise ConfigError(f"environment.wind.file: {path}: speed_mps reaches {speed.max():g}, "
+                          f"above {MAX_WIND_MPS:g} m/s")  # fmt: skip
+    return altitude, speed, from_rad
 
 
 def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
@@ -623,4 +742,8 @@ def load_campaign(path: str | Path) -> Campaign:
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"campaign file not found: {path}")
-    return parse_campaign(path.read_text(), path.parent)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ConfigError("not valid TOML: not UTF-8 text (a binary file?)") from None
+    return parse_campaign(text, path.parent)

@@ -2,14 +2,14 @@
 
 Needs the optional ``distributed`` package (``pip install 'rocketmc[dask]'``). The client sends the
 campaign once (the workers copy it from each other), then one task per chunk index; a worker
-compiles the chunk function on its first chunk and keeps it for the next ones (per process, keyed by
-the campaign's content and the batch), and sends back the chunk's host arrays. The client alone
+compiles the chunk function on its first chunk and keeps it for the next ones (``runner.compiled_chunk``,
+keyed by the campaign's set-up fingerprint and the batch), and sends back the chunk's host arrays. The client alone
 writes the result file.
 
 Realization i's bits depend neither on the worker that flies it nor on that worker's device count
 (``runner``: a compiled batch is whole SIMD vectors on each device), so the file is the one a local
-run writes, provided the workers run the same rocketmc and JAX, with the same precision (checked),
-on the same kind of CPU (XLA compiles for the host's vector instructions).
+run writes, provided the workers run the same rocketmc and numerical packages, with the same precision
+(the set-up is checked on each worker), on the same kind of CPU (XLA compiles for the host's vector instructions).
 
 A worker lost mid-run costs the chunks it held: the scheduler gives them to another worker, first in
 line (up to ``distributed.scheduler.allowed-failures`` times per chunk, then ``KilledWorker``).
@@ -19,35 +19,54 @@ Chunks already received are not flown again (their futures are released on arriv
 
 from __future__ import annotations
 
+import asyncio
 import dataclasses
-import hashlib
 import os
-import pickle
-import threading
 import time
 import uuid
-from collections import OrderedDict, deque
+from collections import deque
 from collections.abc import Callable
 from concurrent.futures import CancelledError
 from contextlib import contextmanager
 
 import jax
 from distributed import Client, KilledWorker, LocalCluster
+from distributed.comm import CommClosedError
 
 from .. import __version__
+from ..errors import RocketmcError
 from .config import Campaign
-from .runner import ChunkResult, batch_size, chunking, compile_chunk, fly_chunk
+from .fingerprint import differences, setup
+from .runner import ChunkResult, batch_size, chunking, compiled_chunk, fly_chunk
 
 CONNECT_TIMEOUT_S = 10.0
 """How long to try reaching a scheduler [s]: a scheduler on the network answers in well under 1 s."""
 
-COMPILED_KEPT = 4
-"""Compiled chunk functions a worker keeps (most recently used), for successive runs on one cluster."""
+ANSWER_MARGIN_S = 2.0
+"""How much longer than ``CONNECT_TIMEOUT_S`` a scheduler reached has to answer [s]: once past it, a port that
+accepted the connection without answering as a Dask scheduler is given up (a refused one, retried by Dask until
+``CONNECT_TIMEOUT_S``, says so first)."""
 
 
-class ClusterError(RuntimeError):
+class ClusterError(RocketmcError, RuntimeError):
     """A Dask cluster that cannot be reached, that lost a chunk for good, or whose workers differ from
     the client; one line."""
+
+
+class _Client(Client):
+    """A ``Client`` whose start ends within ``CONNECT_TIMEOUT_S + ANSWER_MARGIN_S`` [s], closed if it fails.
+
+    Its ``timeout`` bounds the TCP connection and the scheduler's first replies, not the comm handshake between
+    them: ``distributed.comm.core.connect`` awaits the peer's handshake without a deadline (dask/distributed#7698,
+    2023; still so in 2026.8) and no setting bounds it, so a port that accepts and never answers would hold the
+    ``Client`` constructor forever. ``sync``'s ``callback_timeout`` bounds the whole start instead."""
+
+    def start(self, **kwargs):
+        try:
+            super().start(callback_timeout=CONNECT_TIMEOUT_S + ANSWER_MARGIN_S, **kwargs)
+        except BaseException:
+            self.close()  # a start cut short leaves its comm and event loop open
+            raise
 
 
 def worker_env(n_workers: int, devices: int) -> dict[str, str]:
@@ -74,10 +93,20 @@ def cluster(scheduler: str | None = None, workers: int | None = None):
             with Client(local) as client:
                 yield client
         return
+    where, deadline = f"--scheduler {scheduler}", CONNECT_TIMEOUT_S + ANSWER_MARGIN_S
     try:
-        client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        client = _Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+    except (TimeoutError, asyncio.TimeoutError):  # an OSError, asyncio's too from Python 3.11 on
+        raise ClusterError(f"{where}: no answer from a Dask scheduler within {deadline:g} s (the port accepted the "
+                           "connection)") from None  # fmt: skip
+    except CommClosedError:
+        raise ClusterError(f"{where}: the connection was closed without answering as a Dask scheduler") from None
     except (OSError, ValueError) as e:
-        raise ClusterError(f"--scheduler {scheduler}: no Dask scheduler reachable there ({e})") from None
+        raise ClusterError(f"{where}: no Dask scheduler reachable there ({e})") from None
+    except ImportError:  # the scheduler refused this client's packages
+        raise
+    except Exception:  # whatever decoding a foreign answer raises: MemoryError, struct.error, msgpack's, ...
+        raise ClusterError(f"{where}: not a Dask scheduler (its answer is not a scheduler's)") from None
     with client:
         yield client
 
@@ -90,44 +119,22 @@ def describe(client: Client) -> str:
             f"{dashboard}; each worker compiles on its first chunk")  # fmt: skip
 
 
-def environment() -> tuple:
-    """What a worker must share with the client for the same bits: rocketmc and JAX versions, float64."""
-    return __version__, jax.__version__, bool(jax.config.jax_enable_x64)
-
-
-def digest(campaign: Campaign) -> str:
-    """A digest of the campaign's content, the same in every process (its pydantic config's pickle is
-    not: it holds sets of names, whose order changes from one process to the next)."""
-    fields = {field.name: getattr(campaign, field.name) for field in dataclasses.fields(campaign)}
-    fields["config"] = campaign.config.model_dump_json()
-    return hashlib.sha256(pickle.dumps(fields)).hexdigest()
-
-
 def _campaign(campaign: Campaign) -> Campaign:
     """The task that holds the campaign on a worker, whence the others copy it; run again if every
     worker holding it is lost (scattered data would be gone for good)."""
     return campaign
 
 
-_compiled: OrderedDict[tuple[str, int], Callable] = OrderedDict()
-_compile_lock = threading.Lock()
-
-
-def _fly(campaign: Campaign, content: str, chunk_size: int, index: int, client_env: tuple) -> tuple[ChunkResult, float]:
+def _fly(campaign: Campaign, client_setup: dict, chunk_size: int, index: int) -> tuple[ChunkResult, float]:
     """On a worker: chunk ``index``, and the seconds spent compiling for it first [s] (~0 once cached);
-    ``content``: the campaign's ``digest``."""
-    if environment() != client_env:
-        raise ClusterError(f"a worker runs (rocketmc, jax, float64) = {environment()}, the client {client_env}; "
-                           "the bits would differ")  # fmt: skip
+    refused unless the worker's set-up of the campaign (``fingerprint.setup``: package versions and
+    precision among it) is the client's."""
+    differing = differences(setup(campaign), client_setup)
+    if differing:
+        raise ClusterError(f"a worker's set-up differs from the client's ({', '.join(differing)}); the bits would differ")
     batch = batch_size(chunk_size)
     t0 = time.perf_counter()
-    with _compile_lock:  # one compilation per process, whatever its threads
-        compiled = _compiled.pop((content, batch), None)
-        if compiled is None:
-            compiled = compile_chunk(campaign, batch)
-        _compiled[content, batch] = compiled  # the most recently used last
-        while len(_compiled) > COMPILED_KEPT:
-            _compiled.popitem(last=False)
+    compiled = compiled_chunk(campaign, batch)
     compile_s = time.perf_counter() - t0
     return fly_chunk(compiled, campaign, chunk_size, batch, index), compile_s
 
@@ -158,9 +165,9 @@ def run_chunks(client: Client, campaign: Campaign, chunk_size: int | None = None
     run = f"rocketmc-chunk-{uuid.uuid4().hex}"  # task keys unique to this run
     t_last = time.perf_counter()
     shared = client.submit(_campaign, campaign, key=f"{run}-campaign")
-    content, client_env = digest(campaign), environment()
+    client_setup = setup(campaign)
     pending = deque(
-        client.submit(_fly, shared, content, chunk_size, index, client_env, key=(run, index), priority=-position)
+        client.submit(_fly, shared, client_setup, chunk_size, index, key=(run, index), priority=-position)
         for position, index in enumerate(order)
     )
     try:

@@ -12,7 +12,9 @@ holds ``LANES`` flights per core, rounded up; the extra rows are the next indice
 
 from __future__ import annotations
 
+import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -25,6 +27,7 @@ from ..sim.flight import fly_block, flight_done, flight_summary, initial_state, 
 from ..sim.params import FlightParams
 from ..sim.params import SimSettings
 from .config import Campaign
+from .fingerprint import fingerprint, setup
 from .model import flight_params
 from .sampling import realization_key, sample_dispersions
 
@@ -129,6 +132,26 @@ def compile_chunk(campaign: Campaign, batch: int) -> Callable:
     return jax.jit(sharded).lower(key, jnp.zeros(batch, dtype=jnp.uint32)).compile()
 
 
+COMPILED_KEPT = 4
+"""Compiled chunk functions a process keeps (the most recently used): a Dask worker's successive
+chunks and runs, a notebook's or a test's runs of one campaign, compile once."""
+
+_compiled: OrderedDict[tuple[str, int], Callable] = OrderedDict()
+_compile_lock = threading.Lock()
+
+
+def compiled_chunk(campaign: Campaign, batch: int) -> Callable:
+    """``compile_chunk(campaign, batch)``, kept per process by the campaign's set-up fingerprint and
+    the batch; one compilation at a time, whatever the process's threads."""
+    key = fingerprint(setup(campaign)), batch
+    with _compile_lock:
+        compiled = _compiled.pop(key, None) or compile_chunk(campaign, batch)
+        _compiled[key] = compiled  # the most recently used last
+        while len(_compiled) > COMPILED_KEPT:
+            _compiled.popitem(last=False)
+    return compiled
+
+
 @dataclass
 class ChunkResult:
     """Host arrays of one chunk (rows ``start .. start + len``)."""
@@ -165,12 +188,13 @@ def fly_chunk(compiled: Callable, campaign: Campaign, chunk_size: int, batch: in
 def run_chunks(campaign: Campaign, chunk_size: int | None = None, chunks: list[int] | None = None):
     """Yield ``ChunkResult`` for each chunk index (all chunks by default), in order.
 
-    The first item yielded is the compile time [s] (a float); then one ChunkResult per chunk.
+    The first item yielded is the compile time [s] (a float, ~0 when this process compiled the
+    campaign's chunk before); then one ChunkResult per chunk.
     """
     chunk_size, n_chunks = chunking(campaign, chunk_size)
     t0 = time.perf_counter()
     batch = batch_size(chunk_size)
-    compiled = compile_chunk(campaign, batch)
+    compiled = compiled_chunk(campaign, batch)
     yield time.perf_counter() - t0
     for c in range(n_chunks) if chunks is None else chunks:
         yield fly_chunk(compiled, campaign, chunk_size, batch, c)

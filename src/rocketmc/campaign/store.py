@@ -1,80 +1,199 @@
 """HDF5 result files (the output contract of docs/conventions.md), written so that a killed run loses
-at most the chunks in flight.
+at most the chunks in flight and a resumed one never mixes two set-ups.
 
 A run keeps its finished chunks in the folder ``<out>.partial/``: ``manifest.json`` (what the run is:
-campaign text, seed, N, chunk size) and one ``chunk_<k>.h5`` per finished chunk, each written under a
-temporary name, flushed to disk and renamed, so a chunk file that exists is whole. ``finish()`` streams
-the chunk files, one at a time, into ``<out>`` (written the same way) and removes the folder: a file at
-``<out>`` is complete. ``ResultWriter(..., resume=True)`` reopens the folder of a killed run, refuses
-one that belongs to another campaign, and reports which chunks are done.
+its set-up and that set-up's fingerprint, ``fingerprint.py``) and one ``chunk_<k>.h5`` per finished
+chunk (its rows, the fingerprint, its index and first row, each dataset with a Fletcher-32 checksum),
+each written under a temporary name, flushed to disk and renamed, so a chunk file that exists is
+whole. ``finish()`` checks the chunks again and streams them, one at a time, into ``<out>`` (written
+the same way) and removes the folder: a file at ``<out>`` is complete.
+``ResultWriter(..., resume=True)`` reopens the folder of a killed run and checks every file in it
+against the set-up given: a manifest of another set-up or edited by hand, a chunk of another set-up,
+one renamed, truncated or damaged, or a file that is not the run's are refused in one line, and
+nothing is overwritten.
 """
 
 from __future__ import annotations
 
 import json
-import shutil
+import os
+import re
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from .. import __version__
-from ..files import replacing
+from ..errors import RocketmcError
+from ..files import replacing, replacing_hdf5
 from ..sim.flight import Status, unit_of
 from .config import Campaign
-from .runner import ChunkResult
+from .fingerprint import differences, fingerprint, setup
+from .runner import ChunkResult, chunking
+
+MANIFEST = "manifest.json"
+MANIFEST_FORMAT = 2
+"""Version of the partial folder's layout: 2 since the set-up fingerprint (rocketmc 0.1, issue 15)."""
+CHUNK_FILE = re.compile(r"chunk_(\d{6})\.h5")
+SHOWN_DIFFERENCES = 4
+"""Differing set-up fields a refusal names before '...'."""
 
 
-class ResumeError(ValueError):
-    """A partial run that cannot be resumed (another campaign's, or damaged); one line."""
+class ResumeError(RocketmcError, ValueError):
+    """A partial run that cannot be resumed (another set-up's, or damaged); one line."""
+
+
+class WriteError(RocketmcError, OSError):
+    """A chunk or the result file that could not be written (a full disk, a read-only folder); one
+    line saying what is kept and how to complete the run."""
 
 
 def partial_dir(out: Path) -> Path:
     return out.with_name(out.name + ".partial")
 
 
+def _plural(n: int, what: str) -> str:
+    return f"{n} {what}{'' if n == 1 else 's'}"
+
+
+def _read_manifest(path: Path) -> dict:
+    try:
+        found = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError):
+        raise ResumeError(f"{path.parent}: no readable {MANIFEST}, not a rocketmc partial run") from None
+    if not isinstance(found, dict):
+        raise ResumeError(f"{path}: not a rocketmc manifest")
+    return found
+
+
 class ResultWriter:
-    """Writes one campaign's results: ``write(chunk, index)`` per finished chunk, then ``finish()``."""
+    """Writes one campaign's results: ``write(chunk, index)`` per finished chunk, then ``finish()``.
+
+    ``already_complete``: resuming found no partial folder but a complete result file at ``out`` of
+    the same set-up, which is kept (``finish()`` does nothing)."""
 
     def __init__(self, out: str | Path, campaign: Campaign, chunk_size: int, resume: bool = False):
         self.out = Path(out)
         self.dir = partial_dir(self.out)
-        cfg = campaign.config
-        self.n = cfg.n_realizations
-        self.manifest = {"campaign_name": cfg.name, "campaign_toml": campaign.text, "seed": cfg.seed,
-                         "n_realizations": self.n, "chunk_size": chunk_size}  # fmt: skip
-        manifest_path = self.dir / "manifest.json"
+        self.n = campaign.config.n_realizations
+        self.chunk_size, self.n_chunks = chunking(campaign, chunk_size)
+        self.setup = setup(campaign, self.chunk_size)
+        self.fingerprint = fingerprint(self.setup)
+        self.manifest = {"format": MANIFEST_FORMAT, "fingerprint": self.fingerprint, "setup": self.setup}
+        self.already_complete = False
+        self._names: dict[str, set[str]] | None = None  # the datasets of every chunk, from the first checked
+        if self.out.is_dir():
+            raise WriteError(f"{self.out}: is a folder, expected a result file name")
         if resume:
-            try:
-                found = json.loads(manifest_path.read_text())
-            except (OSError, ValueError):
-                raise ResumeError(f"{self.dir}: no readable manifest.json, not a rocketmc partial run") from None
-            differing = [k for k, v in self.manifest.items() if found.get(k) != v]
-            if differing:
-                raise ResumeError(f"{self.dir}: a partial run of another campaign or set-up ({', '.join(differing)} "
-                                  "differ); not resumed, nothing overwritten")  # fmt: skip
+            if not self.dir.exists() and self.out.is_file():
+                self.already_complete = self._check_complete_result()
+                return
+            self._check_manifest(_read_manifest(self.dir / MANIFEST))
+            self._chunks = {index: self._check_chunk(index) for index in self._listed_chunks()}
         else:
             if self.dir.exists():
                 raise ResumeError(f"{self.dir}: a partial run is there already; resume it with --resume or delete it")
-            self.dir.mkdir(parents=True)
-            with replacing(manifest_path) as path:
-                path.write_text(json.dumps(self.manifest, indent=1))
+            try:
+                self.dir.mkdir(parents=True)
+                with replacing(self.dir / MANIFEST) as path:
+                    path.write_text(json.dumps(self.manifest, indent=1))
+            except OSError as e:
+                if self.dir.is_dir() and not any(self.dir.iterdir()):
+                    self.dir.rmdir()
+                raise WriteError(f"{e.filename or self.dir}: could not start the run ({e.strerror or e})") from None
+            self._chunks = {}
+
+    def _check_complete_result(self) -> bool:
+        try:
+            with h5py.File(self.out, "r") as f:
+                complete, found = bool(f.attrs.get("complete", False)), f.attrs.get("fingerprint")
+        except OSError:
+            raise ResumeError(f"{self.out}: no partial run {self.dir.name} to resume, and not a result file") from None
+        if not complete:
+            raise ResumeError(f"{self.out}: no partial run {self.dir.name} to resume, and the file is incomplete")
+        if found != self.fingerprint:
+            raise ResumeError(f"{self.out}: complete already, from another set-up (or an older rocketmc); "
+                              "nothing to resume")  # fmt: skip
+        return True
+
+    def _check_manifest(self, found: dict) -> None:
+        if found == self.manifest:
+            return
+        if found.get("format") != MANIFEST_FORMAT:
+            raise ResumeError(f"{self.dir}: a partial run of another campaign or set-up, by another rocketmc "
+                              f"version (manifest format {found.get('format', 1)!r}); not resumed, nothing overwritten")  # fmt: skip
+        if not isinstance(found.get("setup"), dict) or found.get("fingerprint") != fingerprint(found["setup"]):
+            raise ResumeError(f"{self.dir / MANIFEST}: edited or damaged (its fingerprint does not match its set-up); "
+                              "not resumed, nothing overwritten")  # fmt: skip
+        differing = [path.removeprefix("setup.") for path in differences(found, self.manifest) if path != "fingerprint"]
+        shown = ", ".join(differing[:SHOWN_DIFFERENCES]) + (", ..." if len(differing) > SHOWN_DIFFERENCES else "")
+        raise ResumeError(f"{self.dir}: a partial run of another campaign or set-up ({shown} differ); "
+                          "not resumed, nothing overwritten")  # fmt: skip
+
+    def _listed_chunks(self) -> list[int]:
+        """Indices of the chunk files in the folder; anything there that is not the run's is refused
+        (``finish`` would remove the folder)."""
+        indices = []
+        for path in sorted(self.dir.iterdir()):
+            match = CHUNK_FILE.fullmatch(path.name)
+            if path.name == MANIFEST or (path.name.endswith(".writing") and path.is_file()):
+                continue  # .writing: a write cut short by a kill, replaced when its chunk is written
+            if match is None or not path.is_file():
+                raise ResumeError(f"{path}: not a file of a rocketmc partial run; move it out of {self.dir.name} "
+                                  "and resume")  # fmt: skip
+            index = int(match.group(1))
+            if index >= self.n_chunks:
+                raise ResumeError(f"{path}: chunk {index} of a run of {self.n_chunks} chunks; not resumed")
+            indices.append(index)
+        return indices
 
     def _chunk_path(self, index: int) -> Path:
         return self.dir / f"chunk_{index:06d}.h5"
 
+    def _rows(self, index: int) -> int:
+        return min(self.chunk_size, self.n - index * self.chunk_size)
+
+    def _check_chunk(self, index: int) -> int:
+        """Check chunk ``index``'s file whole (every byte read, checksums verified) and of this run;
+        return its number of rows."""
+        path = self._chunk_path(index)
+        try:
+            with h5py.File(path, "r") as chunk:
+                attrs = {k: chunk.attrs.get(k) for k in ("fingerprint", "chunk_index", "start")}
+                names = {group: set(chunk.get(group, {})) for group in ("outputs", "inputs")}
+                lengths = {len(chunk[group][name][()]) for group in names for name in names[group]}
+        except (OSError, KeyError, TypeError, ValueError) as e:
+            raise ResumeError(f"{path}: unreadable (truncated or damaged: {str(e).splitlines()[0]}); delete it and "
+                              "resume to fly that chunk again") from None  # fmt: skip
+        if attrs["fingerprint"] != self.fingerprint:
+            raise ResumeError(f"{path}: a chunk of another set-up; not resumed, nothing overwritten")
+        if attrs["chunk_index"] != index or attrs["start"] != index * self.chunk_size:
+            raise ResumeError(f"{path}: holds the rows of chunk {attrs['chunk_index']} (renamed or copied); "
+                              "not resumed, nothing overwritten")  # fmt: skip
+        if self._names is None:
+            self._names = names
+        if names != self._names or "status" not in names["outputs"] or lengths != {self._rows(index)}:
+            raise ResumeError(f"{path}: its datasets differ from the run's (edited); not resumed, nothing overwritten")
+        return self._rows(index)
+
     def completed_chunks(self) -> list[int]:
         """Indices of the chunks already written."""
-        return sorted(int(p.stem.removeprefix("chunk_")) for p in self.dir.glob("chunk_*.h5"))
+        return sorted(self._chunks)
 
     def write(self, chunk: ChunkResult, chunk_index: int) -> None:
         """Commit one chunk: written whole or not at all."""
-        with replacing(self._chunk_path(chunk_index)) as path, h5py.File(path, "w") as f:
-            f.attrs["start"] = chunk.start
-            for group, data in (("outputs", chunk.outputs), ("inputs", chunk.inputs)):
-                g = f.create_group(group)
-                for name, values in data.items():
-                    g.create_dataset(name, data=values)
+        path = self._chunk_path(chunk_index)
+        try:
+            with replacing_hdf5(path, libver="latest") as f:  # checksummed datasets stored compactly (HDF5 ≥ 1.10)
+                f.attrs.update({"fingerprint": self.fingerprint, "chunk_index": chunk_index, "start": chunk.start})
+                for group, data in (("outputs", chunk.outputs), ("inputs", chunk.inputs)):
+                    g = f.create_group(group)
+                    for name, values in data.items():
+                        g.create_dataset(name, data=values, fletcher32=True)
+        except OSError as e:
+            raise WriteError(f"{path}: could not write ({e.strerror or e}); the {_plural(len(self._chunks), 'chunk')} "
+                             f"finished are kept in {self.dir}: free space and run the same command with --resume") from None  # fmt: skip
+        self._chunks[chunk_index] = len(chunk.outputs["status"])
 
     def chunk_outputs(self, index: int, names) -> dict[str, np.ndarray]:
         """Some ``/outputs`` of a written chunk."""
@@ -82,33 +201,47 @@ class ResultWriter:
             return {name: chunk["outputs"][name][()] for name in names}
 
     def finish(self, n_rows: int | None = None) -> Path:
-        """Gather the chunks into ``<out>`` (complete) and remove the partial folder. ``n_rows``: the
-        realizations kept when a run stopped early (``--until-converged``), the first chunks' rows."""
+        """Check the chunks and gather them into ``<out>`` (complete), then remove the partial folder.
+        ``n_rows``: the realizations kept when a run stopped early (``--until-converged``), the first
+        chunks' rows."""
+        if self.already_complete:
+            return self.out
         n = self.n if n_rows is None else n_rows
-        done = [c for c in self.completed_chunks() if c * self.manifest["chunk_size"] < n]
-        with replacing(self.out) as path, h5py.File(path, "w") as f:
-            f.attrs.update({k: v for k, v in self.manifest.items()})
-            f.attrs["n_realizations"] = n
-            f.attrs["rocketmc_version"] = __version__
-            f.attrs["completed_chunks"] = np.asarray(done, dtype=np.int64)
-            f.create_group("outputs")
-            f.create_group("inputs")
-            rows = 0
-            for index in done:
-                try:
+        needed = range(-(-n // self.chunk_size))
+        missing = [index for index in needed if index not in self._chunks]
+        if missing:
+            raise ResumeError(f"{self.dir}: chunk(s) {', '.join(map(str, missing[:5]))} missing; resume to fly them")
+        for index in needed:
+            self._check_chunk(index)  # again: a chunk could have changed since it was written or checked
+        try:
+            with replacing_hdf5(self.out) as f:
+                config = self.setup["config"]
+                f.attrs.update({
+                    "campaign_name": config["name"], "seed": config["seed"], "n_realizations": n,
+                    "chunk_size": self.chunk_size, "completed_chunks": np.asarray(needed, dtype=np.int64),
+                    "rocketmc_version": __version__, "fingerprint": self.fingerprint,
+                    "campaign_toml": self.setup["campaign_toml"],  # apart from the rest: an attribute holds ≤ 64 kB
+                    "setup": json.dumps({k: v for k, v in self.setup.items() if k != "campaign_toml"}),
+                })  # fmt: skip
+                f.create_group("outputs")
+                f.create_group("inputs")
+                for index in needed:
                     with h5py.File(self._chunk_path(index), "r") as chunk:
-                        start = int(chunk.attrs["start"])
+                        start = index * self.chunk_size
                         for group in ("outputs", "inputs"):
                             for name, ds in chunk[group].items():
-                                values = ds[()]
+                                values = ds[: max(0, min(len(ds), n - start))]
                                 self._dataset(f, group, name, values, n)[start : start + len(values)] = values
-                        rows += len(chunk["outputs/status"])
-                except (OSError, KeyError) as e:
-                    raise ResumeError(f"{self._chunk_path(index)}: unreadable chunk ({e}); delete it and resume") from None
-            if rows != n:
-                raise ResumeError(f"{self.dir}: the chunks hold {rows} of {n} realizations")
-            f.attrs["complete"] = True
-        shutil.rmtree(self.dir)
+                f.attrs["complete"] = True
+        except OSError as e:
+            raise WriteError(f"{self.out}: could not write ({e.strerror or e}); all {_plural(len(needed), 'chunk')} are "
+                             f"kept in {self.dir}: free space and run the same command with --resume") from None  # fmt: skip
+        for path in [self.dir / MANIFEST, *map(self._chunk_path, self._chunks)]:
+            path.unlink()
+        try:
+            self.dir.rmdir()
+        except OSError:  # a file put there since the checks: the user's, kept
+            pass
         return self.out
 
     @staticmethod

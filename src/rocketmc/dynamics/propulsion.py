@@ -73,9 +73,13 @@ def _rse_rows(path: Path) -> list[tuple[float, float]]:
 
 def _text_rows(path: Path) -> list[tuple[float, float]]:
     """(time, thrust) of a RASP ``.eng`` file (its first non-comment line is the header) or a CSV."""
+    try:
+        text = path.read_bytes().decode("utf-8-sig")  # -sig: spreadsheets often start with a BOM
+    except UnicodeDecodeError:
+        raise ThrustCurveError(f"{path}: not a UTF-8 text file") from None
     rows = []
     header_seen = path.suffix.lower() != ".eng"
-    for line in path.read_text().splitlines():
+    for line in text.splitlines():
         line = line.split(";")[0].strip()
         if not line:
             continue
@@ -95,12 +99,16 @@ def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """Read a RASP ``.eng``, a RockSim ``.rse`` or a two-column CSV (time [s], thrust [N]).
 
     Returns (time, thrust) arrays starting at (0, 0): RASP curves leave the ignition point
-    implicit, so it is added when the first time is positive.
+    implicit, so it is added when the first time is positive. ``ThrustCurveError`` naming the file
+    and what is wrong, also for a file that cannot be read or is not text.
     """
     path = Path(path)
     if not path.is_file():
         raise ThrustCurveError(f"thrust curve file not found: {path}")
-    rows = _rse_rows(path) if path.suffix.lower() == ".rse" else _text_rows(path)
+    try:
+        rows = _rse_rows(path) if path.suffix.lower() == ".rse" else _text_rows(path)
+    except OSError as err:
+        raise ThrustCurveError(f"{path}: cannot be read ({err.strerror or err})") from None
     if len(rows) < 2:
         raise ThrustCurveError(f"{path}: fewer than two thrust points")
     t, f = np.array(rows, dtype=float).T
@@ -110,6 +118,10 @@ def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
         raise ThrustCurveError(f"{path}: times must increase from >= 0 and thrust must be >= 0")
     if t[0] > 0:
         t, f = np.concatenate([[0.0], t]), np.concatenate([[0.0], f])
+    with np.errstate(over="ignore"):
+        total_impulse_ns = cumulative_impulse(t, f)[-1]
+    if not 0.0 < total_impulse_ns < np.inf:  # the mass flow is F·m_p0/I_tot
+        raise ThrustCurveError(f"{path}: the total impulse must be positive and finite, got {total_impulse_ns:g} N·s")
     return t, f
 
 

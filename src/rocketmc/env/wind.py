@@ -107,11 +107,17 @@ def read_wind_profile(path, site_altitude_m: float) -> tuple[np.ndarray, np.ndar
 
     The CSV (``#`` comments allowed) has a header naming ``altitude_agl_m`` or ``altitude_msl_m``
     (the latter made relative to ``site_altitude_m``), ``speed_mps`` and ``from_deg``; altitudes strictly
-    increasing. ``ValueError`` naming what is wrong.
+    increasing. ``ValueError`` naming the file and what is wrong, also for a file that is not text.
     """
-    with Path(path).open(newline="") as f:
-        rows = list(csv.DictReader(line for line in f if line.strip() and not line.lstrip().startswith("#")))
-    header = list(rows[0]) if rows else []
+    try:
+        with Path(path).open(newline="", encoding="utf-8-sig") as f:  # -sig: spreadsheets often start with a BOM
+            reader = csv.DictReader(line for line in f if line.strip() and not line.lstrip().startswith("#"))
+            rows = list(reader)
+            header = reader.fieldnames or []
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a UTF-8 text file") from None
+    except csv.Error as err:  # e.g. a NUL byte
+        raise ValueError(f"{path}: not a readable CSV file ({err})") from None
     altitude_columns = [c for c in ("altitude_agl_m", "altitude_msl_m") if c in header]
     if len(altitude_columns) != 1 or not {"speed_mps", "from_deg"} <= set(header):
         raise ValueError(f"{path}: expected columns altitude_agl_m (or altitude_msl_m), speed_mps and from_deg, "

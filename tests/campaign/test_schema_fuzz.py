@@ -1,0 +1,356 @@
+"""Fuzzed campaigns (issue 15): every number finite and in its physical range, every value a dispersion
+can draw valid, the name a label, broken input files refused: each as one ConfigError line naming the
+field, checked at load time. No flight is flown."""
+
+import copy
+import math
+import re
+import tomllib
+from pathlib import Path
+
+import h5py
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rocketmc.aero.io import lynx_datcom_tables, save_aero_tables
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign
+from rocketmc.campaign.config import (
+    MAX_NAME_LENGTH,
+    MAX_REALIZATIONS,
+    MIN_CONTROL_DT_S,
+    MIN_MASS_KG,
+    NORMAL_REACH_STD,
+    flatten_numbers,
+    preset_rocket,
+)
+from rocketmc.cli import main
+
+ROOT = Path(__file__).parents[2]
+CAMPAIGNS = ROOT / "campaigns"
+SHIPPED = sorted(CAMPAIGNS.glob("*.toml")) + sorted((ROOT / "src" / "rocketmc" / "data" / "campaigns").glob("*.toml"))
+NOMINAL = (CAMPAIGNS / "lynx_nominal.toml").read_text()
+RAW = tomllib.loads(NOMINAL)
+assert RAW["rocket"] == {"preset": "lynx"}  # so that EXPANDED is the same campaign
+EXPANDED = {**RAW, "rocket": preset_rocket("lynx")}
+"""lynx_nominal with the preset's rocket written out: every number of the campaign is a leaf."""
+BINARY = bytes(range(256)) * 4  # 0x80-0xff alone are not UTF-8; NUL and other control bytes besides
+FIELD_PREFIX = re.compile(r"^[a-z_]+(\.[A-Za-z0-9_]+)*: ")
+"""How every ConfigError starts: the dotted path of the field (or a top-level key), a colon."""
+
+
+def replaced(raw: dict, keys, value) -> dict:
+    """A copy of ``raw`` with the leaf at ``keys`` (a dotted path, or a tuple where a key holds dots) set."""
+    keys = keys.split(".") if isinstance(keys, str) else keys
+    raw = copy.deepcopy(raw)
+    node = raw
+    for key in keys[:-1]:
+        node = node[int(key)] if isinstance(node, list) else node[key]
+    if isinstance(node, list):
+        node[int(keys[-1])] = value
+    else:
+        node[keys[-1]] = value
+    return raw
+
+
+def with_dispersion(path: str, **dispersion) -> dict:
+    """The expanded nominal campaign with the dispersion of ``path`` replaced (or added)."""
+    return {**EXPANDED, "dispersions": {**EXPANDED["dispersions"], path: dispersion}}
+
+
+def refusal(raw: dict, base_dir: Path = CAMPAIGNS) -> str:
+    """The message of the ConfigError that loading ``raw`` raises, checked to be one line."""
+    with pytest.raises(ConfigError) as info:
+        campaign_from_dict(raw, base_dir)
+    message = str(info.value)
+    assert "\n" not in message and FIELD_PREFIX.match(message), message
+    return message
+
+
+def test_expanded_nominal_is_valid():
+    """The base of every case below loads: each refusal is the edit's doing."""
+    campaign = campaign_from_dict(EXPANDED, CAMPAIGNS)
+    assert campaign.nominal == campaign_from_dict(RAW, CAMPAIGNS).nominal
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: str(p.relative_to(ROOT)))
+def test_shipped_campaigns_still_load(path):
+    assert load_campaign(path).config.n_realizations >= 1
+
+
+NUMBER_FIELDS = [
+    "environment.wind.layers.0.speed_mps",
+    "environment.wind.layers.2.from_deg",
+    "environment.wind.layers.1.thickness_m",
+    "environment.turbulence.severity",
+    "rocket.motor.thrust_scale",
+    "rocket.motor.ignition_delay_s",
+    "rocket.dry_mass_kg",
+    "rocket.dry_inertia_kgm2.1",
+    "rocket.aero.cd.3",
+    "rocket.aero.linear.cm_q",
+    "rocket.geometry.fins.0.span_m",
+    "rocket.parachutes.1.area_m2",
+    "launch.rail_length_m",
+    "site.altitude_m",
+    "simulation.max_time_s",
+]
+
+
+@pytest.mark.parametrize("value", [math.inf, -math.inf, math.nan], ids=["inf", "-inf", "nan"])
+@pytest.mark.parametrize("path", NUMBER_FIELDS)
+def test_non_finite_numbers_are_refused_naming_the_field(path, value):
+    message = refusal(replaced(EXPANDED, path, value))
+    assert message.startswith(f"{path}: Input should be a finite number"), message
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "words"),
+    [
+        ("environment.wind.layers.0.speed_mps", 1e4, "less than or equal to"),  # 10 km/s: no wind on Earth
+        ("environment.turbulence.w20_mps", 1e3, "less than or equal to"),
+        ("rocket.motor.thrust_scale", 100.0, "less than or equal to"),  # a unit slip, not a motor lot
+        ("rocket.motor.thrust_scale", 0.0, "greater than 0"),
+        ("rocket.motor.ignition_delay_s", 1e6, "less than or equal to"),  # 11 days on the pad
+        ("rocket.motor.ignition_delay_s", -1.0, "greater than or equal to 0"),
+        ("simulation.max_time_s", 1e9, "less than or equal to"),  # 30 years of flight
+        ("simulation.control_dt_s", 1e-9, f"greater than or equal to {MIN_CONTROL_DT_S}"),  # 10⁹ Hz: never ends
+        ("rocket.dry_mass_kg", 1e6, "less than or equal to"),  # a thousand tonnes
+        ("rocket.dry_mass_kg", 1e-30, f"greater than or equal to {MIN_MASS_KG}"),
+        ("rocket.dry_inertia_kgm2.0", 0.0, "greater than or equal to"),
+        ("rocket.geometry.length_m", 1e3, "less than or equal to"),  # a kilometre-long rocket
+        ("rocket.geometry.body_diameter_m", -0.15, "greater than or equal to"),
+        ("rocket.parachutes.0.cd", 50.0, "less than or equal to"),  # 20 × the draggiest canopy
+        ("rocket.parachutes.1.area_m2", 1e5, "less than or equal to"),  # 10 ha of canopy
+        ("rocket.parachutes.0.delay_s", -0.5, "greater than or equal to 0"),
+        ("rocket.aero.drag_scale", 1e3, "less than or equal to"),
+        ("rocket.aero.cd_mach.5", 1e3, "less than or equal to"),  # Mach 1000
+        ("rocket.aero.linear.cm_q", -1e9, "greater than or equal to"),
+        ("rocket.aero.linear.cn_alpha", 1e6, "less than or equal to"),
+        ("launch.rail_length_m", 0.0, "greater than or equal to"),
+        ("n_realizations", 10**12, f"less than or equal to {MAX_REALIZATIONS}"),
+    ],
+)  # fmt: skip
+def test_absurd_magnitudes_are_refused_naming_the_field(path, value, words):
+    message = refusal(replaced(EXPANDED, path, value))
+    assert message.startswith(f"{path}: ") and words in message, message
+
+
+def test_geometry_and_power_law_consistency():
+    """A nose longer than the rocket (it divided by zero in the build-up) and a power-law reference
+    height below the 1 m the law is held at (the stated speed would never be flown) are refused."""
+    message = refusal(replaced(EXPANDED, "rocket.geometry.nose.length_m", 3.0))
+    assert message.startswith("rocket.geometry: nose.length_m (3.0) exceeds length_m (2.495)"), message
+    campaign_from_dict(replaced(EXPANDED, "rocket.geometry.nose.length_m", 2.495), CAMPAIGNS)  # a nose-only body
+    wind = {"model": "power_law", "speed_mps": 6.0, "from_deg": 270.0, "reference_height_m": 0.01}
+    raw = {**replaced(EXPANDED, "environment.wind", wind), "dispersions": {}}
+    assert refusal(raw).startswith("environment.wind.reference_height_m: Input should be greater than or equal to 1")
+
+
+@pytest.mark.parametrize(
+    ("key", "value"), [("std", math.inf), ("std", math.nan), ("low", -math.inf), ("high", math.inf), ("mean", math.nan)]
+)
+def test_non_finite_dispersion_parameters_are_refused(key, value):
+    dispersion = {"dist": "normal", "std": 0.03, "low": 0.85, "high": 1.15, key: value}
+    message = refusal(with_dispersion("rocket.motor.thrust_scale", **dispersion))
+    assert message.startswith(f"dispersions.rocket.motor.thrust_scale.{key}: Input should be a finite number"), message
+
+
+def test_non_finite_uniform_and_choice_parameters_are_refused():
+    uniform = with_dispersion("environment.wind.layers.0.speed_mps", dist="uniform", low=0.0, high=math.inf)
+    assert refusal(uniform).startswith("dispersions.environment.wind.layers.0.speed_mps.high: Input should be a finite")
+    choice = with_dispersion("environment.turbulence.severity", dist="choice", values=[0.0, math.nan])
+    assert refusal(choice).startswith("dispersions.environment.turbulence.severity.values.1: Input should be a finite")
+
+
+def test_normal_clip_range_must_contain_the_mean():
+    """thrust_scale's nominal is 1: a clip range [1.05, 1.15] would draw 1.05 far more often than anything else."""
+    message = refusal(with_dispersion("rocket.motor.thrust_scale", dist="normal", std=0.03, low=1.05, high=1.15))
+    assert message == ("dispersions.rocket.motor.thrust_scale: the clip range [1.05, 1.15] excludes the mean 1.0 "
+                       "(the nominal value, as no mean is given)"), message  # fmt: skip
+    message = refusal(with_dispersion("rocket.motor.thrust_scale", dist="normal", mean=0.8, std=0.03, low=0.85))
+    assert message == "dispersions.rocket.motor.thrust_scale: the clip range [0.85, None] excludes the mean 0.8"
+    campaign_from_dict(with_dispersion("rocket.motor.thrust_scale", dist="normal", std=0.03, low=1.0, high=1.15))
+
+
+def test_unclipped_normal_is_checked_at_six_std():
+    """dry mass 18.362 kg, std 5 kg, no low: 6·std below the mean is a negative mass. Clipping that side is
+    the fix; the high side, unclipped, is checked too (elevation 84° + 6 · 2° > 90°)."""
+    message = refusal(with_dispersion("rocket.dry_mass_kg", dist="normal", std=5.0))
+    assert message.startswith("dispersions.rocket.dry_mass_kg: draws a value -11.63") and "clip it with low" in message
+    assert "rocket.dry_mass_kg: Input should be greater than or equal to" in message, message
+    campaign_from_dict(with_dispersion("rocket.dry_mass_kg", dist="normal", std=5.0, low=10.0))
+    message = refusal(with_dispersion("launch.elevation_deg", dist="normal", std=2.0))
+    assert "mean + 6·std; clip it with high" in message and "launch.elevation_deg: Input should be less" in message
+
+
+@pytest.mark.parametrize(("factor", "valid"), [(0.99, True), (1.01, False)])
+def test_unclipped_reach_is_six_std_exactly(factor, valid):
+    """Drogue cd 0.9 (> 0): std = factor · 0.9/6 puts mean − 6·std just inside or just outside the range;
+    1 % either side so that the float rounding of 6·std cannot decide."""
+    raw = with_dispersion("rocket.parachutes.0.cd", dist="normal", std=factor * 0.9 / NORMAL_REACH_STD, high=1.3)
+    if valid:
+        campaign_from_dict(raw, CAMPAIGNS)
+    else:
+        assert refusal(raw).startswith("dispersions.rocket.parachutes.0.cd: draws a value -0.009")
+
+
+@pytest.mark.parametrize("name", ["../../etc/passwd", "a/b\\c", "x" * MAX_NAME_LENGTH, "Lynx à Roccaraso — 2021"])
+def test_a_name_is_a_label_kept_as_given(name):
+    """Slashes and dots are a label's business (the CLI derives a file name from it); it loads verbatim."""
+    assert campaign_from_dict({**EXPANDED, "name": name}, CAMPAIGNS).config.name == name
+
+
+@pytest.mark.parametrize(
+    "name", ["", "   ", "two\nlines", "tab\there", "nul\x00", "x" * (MAX_NAME_LENGTH + 1), "x" * 10_000],
+    ids=["empty", "blank", "newline", "tab", "nul", "129-characters", "10000-characters"],
+)
+def test_bad_names_are_one_line(name):
+    message = refusal({**EXPANDED, "name": name})
+    assert message.startswith(f"name: expected a label: 1 to {MAX_NAME_LENGTH} printable characters"), message
+    assert len(message) < 300, message  # one readable line: a long name is shown shortened, not in full
+
+
+def thrust_curve_campaign(tmp_path: Path, content: bytes | None, name: str = "motor.eng") -> dict:
+    """The nominal campaign flying ``tmp_path / name`` (written with ``content``, a folder if None)."""
+    target = tmp_path / name
+    target.mkdir() if content is None else target.write_bytes(content)
+    return replaced(EXPANDED, "rocket.motor.thrust_curve", name)
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "words"),
+    [
+        ("motor.eng", BINARY, "not a UTF-8 text file"),
+        ("motor.csv", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "not a UTF-8 text file"),
+        ("motor.rse", BINARY, "not a readable RockSim .rse file"),
+        ("motor.eng", b"", "fewer than two thrust points"),
+        ("motor.eng", None, "is not a file"),
+        ("motor.eng", b"L1350 75 621 0 1.905 4.263 CTI\n0.02 1400\n0.0", "cannot read the line '0.0'"),
+        ("motor.csv", b"0.1,100\n0.2", "cannot read the line"),
+        ("motor.csv", b"0.0,0\n1.0,0\n", "total impulse must be positive"),  # ṁ = F·m_p0/I_tot
+    ],
+    ids=["binary-eng", "png-csv", "binary-rse", "empty", "folder", "truncated-eng", "truncated-csv", "no-impulse"],
+)
+def test_broken_thrust_files_name_the_field(tmp_path, name, content, words):
+    message = refusal(thrust_curve_campaign(tmp_path, content, name), tmp_path)
+    assert message.startswith("rocket.motor.thrust_curve: ") and words in message, message
+
+
+@pytest.mark.parametrize(
+    ("content", "words"),
+    [
+        (BINARY, "not a UTF-8 text file"),
+        (b"altitude_agl_m,speed_mps,from_deg\n0,2,270\x00\n1000,12,270\n", "every row needs numbers"),
+        (b"altitude_agl_m,speed_mps,from_deg\n" + b"7" * 200_000, "not a readable CSV file"),  # > csv's field limit
+        (b"altitude_agl_m,speed_mps,from_deg\n0,2,270\n1000,", "every row needs numbers"),
+        (b"", "expected columns"),
+        (b"altitude_agl_m,speed_mps,from_deg\n0,2,270\n1000,1200,270\n", "speed_mps reaches 1200"),
+    ],
+    ids=["binary", "nul-byte", "huge-field", "truncated", "empty", "1200-mps"],
+)
+def test_broken_wind_profiles_name_the_field(tmp_path, content, words):
+    (tmp_path / "wind.csv").write_bytes(content)
+    wind = {"model": "profile", "file": "wind.csv", "speed_scale": 1.0}
+    raw = {**replaced(EXPANDED, "environment.wind", wind), "dispersions": {}}
+    message = refusal(raw, tmp_path)
+    assert message.startswith("environment.wind.file: ") and words in message, message
+
+
+@pytest.mark.parametrize(
+    ("rocket", "message_start"),
+    [
+        ({"preset": "lynx", "motor": {"thrust_curve": "x" * 10_000}}, "rocket.motor.thrust_curve: cannot look up 'xxx"),
+        ({"preset": "../rockets/lynx"}, "rocket.preset: unknown preset '../rockets/lynx' (available: lynx, lynx_2021)"),
+        ({"preset": "x" * 10_000}, "rocket.preset: unknown preset 'xxx"),
+    ],
+    ids=["long-file-name", "preset-path", "long-preset"],
+)
+def test_file_and_preset_names_are_names(rocket, message_start):
+    """A file name too long for the file system and a preset given as a path are one line each."""
+    message = refusal({**RAW, "rocket": rocket})
+    assert message.startswith(message_start) and len(message) < 300, message  # the long name is shortened
+
+
+def truncated_h5(tmp_path: Path) -> bytes:
+    """The first half of a valid rocketmc aero table file."""
+    save_aero_tables(tmp_path / "whole.h5", lynx_datcom_tables())
+    data = (tmp_path / "whole.h5").read_bytes()
+    assert h5py.is_hdf5(tmp_path / "whole.h5")
+    return data[: len(data) // 2]
+
+
+@pytest.mark.parametrize(
+    ("name", "words"),
+    [("aero.csv", "not a UTF-8 text file"), ("aero.h5", "not a readable HDF5 file"),
+     ("truncated.h5", "not a readable HDF5 file"), ("aero.mat", "not a readable MATLAB .mat file")],
+)  # fmt: skip
+def test_broken_aero_tables_name_the_field(tmp_path, name, words):
+    (tmp_path / name).write_bytes(truncated_h5(tmp_path) if name == "truncated.h5" else BINARY)
+    aero = {"model": "interpolated", "tables": name}
+    if name.endswith(".mat"):  # a .mat does not record its reference values
+        aero.update(reference_area_m2=0.01767, reference_length_m=0.15, moment_reference_m=1.49)
+    message = refusal(replaced(EXPANDED, "rocket.aero", aero), tmp_path)
+    assert message.startswith(f"rocket.aero.tables: {tmp_path / name}: {words}"), message
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ("speed_mps = 7.5", "speed_mps = inf", "environment.wind.layers.0.speed_mps"),
+        ('preset = "lynx"', 'preset = "lynx"\nmotor.thrust_scale = nan', "rocket.motor.thrust_scale"),
+        ('preset = "lynx"', 'preset = "lynx"\nmotor.ignition_delay_s = inf', "rocket.motor.ignition_delay_s"),
+        ("max_time_s = 300.0", "max_time_s = inf", "simulation.max_time_s"),
+        ("std = 0.03, low = 0.85", "std = 0.03, low = 1.05", "dispersions.rocket.motor.thrust_scale"),
+        ('name = "lynx_nominal"', 'name = "../lynx\\nnominal"', "name"),
+        ('name = "lynx_nominal"', f'name = "{"x" * 10_000}"', "name"),
+        ('preset = "lynx"', 'preset = "lynx"\nmotor.thrust_curve = "binary.eng"', "rocket.motor.thrust_curve"),
+        ('preset = "lynx"', 'preset = "lynx"\naero.tables = "binary.csv"', "rocket.aero.tables"),
+    ],
+    ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
+         "long-name", "binary-thrust-file", "binary-aero-csv"],
+)  # fmt: skip
+def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
+    assert old in NOMINAL, old
+    (tmp_path / "binary.eng").write_bytes(BINARY)
+    (tmp_path / "binary.csv").write_bytes(BINARY)
+    campaign = tmp_path / "bad.toml"
+    campaign.write_text(NOMINAL.replace(old, new, 1))
+    before = set(tmp_path.iterdir())
+    assert main(["run", str(campaign), "--out", str(tmp_path / "x.h5")]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("rocketmc: error:") and f": {field}: " in lines[0], lines
+    assert len(lines[0]) < 400, lines[0]  # the 10 000-character name is not echoed
+    assert set(tmp_path.iterdir()) == before  # neither x.h5 nor x.h5.partial/
+
+
+def leaf_paths(raw: dict) -> list[tuple[str, ...]]:
+    """The keys to every numeric leaf of a campaign's tables (``flatten_numbers``' dotted paths, each
+    dispersion's dotted name kept whole)."""
+    paths = [tuple(p.split(".")) for p in flatten_numbers({k: v for k, v in raw.items() if k != "dispersions"})]
+    for name, dispersion in raw["dispersions"].items():
+        paths += [("dispersions", name, *p.split(".")) for p in flatten_numbers(dispersion)]
+    return paths
+
+
+LEAVES = leaf_paths(EXPANDED)
+EDGE_VALUES = [math.inf, -math.inf, math.nan, 1e308, -1e308, 5e-324, 0.0, -1.0, 1e6, -1e6]
+
+
+@settings(max_examples=300, deadline=None, database=None)  # ~3 ms a campaign: ~1 s; no example database
+@given(
+    keys=st.sampled_from(LEAVES),
+    value=st.one_of(st.sampled_from(EDGE_VALUES), st.floats(), st.floats(-1e4, 1e4), st.integers(-10**20, 10**20)),
+)
+def test_any_number_anywhere_loads_finite_or_names_the_field(keys, value):
+    """One numeric leaf of the (valid) nominal campaign replaced: it loads with every number finite, or the
+    ConfigError names a field of the edited section (or a dispersion, whose draws depend on the nominal)."""
+    try:
+        campaign = campaign_from_dict(replaced(EXPANDED, keys, value), CAMPAIGNS)
+    except ConfigError as e:
+        message = str(e)
+        assert "\n" not in message and FIELD_PREFIX.match(message), message
+        assert re.match("[a-z_]+", message).group() in (keys[0], "dispersions"), (keys, message)
+    else:
+        numbers = {**flatten_numbers(campaign.config.model_dump()), **campaign.nominal}
+        assert all(math.isfinite(x) for x in numbers.values()), (keys, value)
