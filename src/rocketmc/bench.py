@@ -60,15 +60,20 @@ def single_flights(campaign) -> Callable:
 
 
 def seconds_per_flight(functions: dict[str, tuple[Callable, int]], master_key, repeats: int) -> dict[str, float]:
-    """Best wall time per flight [s] of each ``name: (f, n)``, ``f(master_key, indices 0..n-1)``, over
-    ``repeats`` rounds that interleave the functions (so that machine noise hits all alike)."""
+    """Best process CPU time per flight [s] of each ``name: (f, n)``, ``f(master_key, indices 0..n-1)``,
+    over ``repeats`` rounds that interleave the functions (so that machine noise hits all alike).
+
+    CPU time, not wall time: other programs on the cores (a busy laptop, a shared CI runner) stretch
+    wall times, unevenly between functions, but not this process's CPU time. XLA's CPU thread pool
+    keeps every core busy even for a single flight (measured on 2 cores: a loop's CPU time is twice its
+    wall time, as a batch's is), so the ratios are those of wall times on an idle machine."""
     best = dict.fromkeys(functions, float("inf"))
     for _ in range(repeats):
         for name, (f, n) in functions.items():
             indices = np.arange(n, dtype=np.uint32)
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             jax.block_until_ready(f(master_key, indices))
-            best[name] = min(best[name], (time.perf_counter() - t0) / n)
+            best[name] = min(best[name], (time.process_time() - t0) / n)
     return best
 
 
