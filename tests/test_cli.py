@@ -1,6 +1,8 @@
 """The command line: a small campaign end to end, and bad input (exit code 2, no result file)."""
 
+import itertools
 import json
+import re
 from pathlib import Path
 
 import h5py
@@ -118,3 +120,48 @@ def test_until_converged_stops_by_itself(tmp_path, capsys):
     with pytest.raises(SystemExit) as info:
         main([*args, "--until-converged", "0"])
     assert info.value.code == 2
+
+
+README = Path(__file__).parents[1] / "README.md"
+OPTION = re.compile(r"(?<![\w-])--?[a-z][a-z0-9-]*")  # -n, --chunk-size; not the -2021 of roccaraso-2021
+
+
+def _readme_commands():
+    """{subcommand words: (options, {option or positional: choices})} of README's "Using it" block."""
+    block = README.read_text().split("## Using it", 1)[1].split("```sh", 1)[1].split("```", 1)[0]
+    commands = {}
+    for text in re.split(r"\n(?=rocketmc )", block.strip()):
+        tokens = text.split()[1:]
+        words = tuple(itertools.takewhile(lambda w: re.fullmatch(r"[a-z]+", w), tokens))
+        listed = re.findall(r"(--[a-z-]+) ([a-z0-9-]+(?:\|[a-z0-9-]+)+)", text)  # --aero-model a|b|c
+        choices = {option: set(values.split("|")) for option, values in listed}
+        positional = tokens[len(words)]
+        if re.fullmatch(r"[a-z0-9-]+(\|[a-z0-9-]+)+", positional):  # roccaraso-2021|euroc-2021, not lynx|CAMPAIGN.toml
+            choices[None] = set(positional.split("|"))
+        commands[words] = (set(OPTION.findall(text)), choices)
+    return commands
+
+
+def _help(capsys, *words):
+    with pytest.raises(SystemExit) as info:
+        main([*words, "--help"])
+    assert info.value.code == 0
+    return capsys.readouterr().out
+
+
+def test_help_matches_the_readme(capsys):
+    """`--help` of the program and of each subcommand against README's "Using it" block: the same
+    subcommands, and for each the same options (both ways: an option dropped from the parser or one
+    added without the README saying so fails) and the same choices where the README lists them."""
+    documented = _readme_commands()
+    assert set(documented) == {("run",), ("report",), ("aero", "derivatives"), ("validate",), ("bench",)}
+    listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
+    assert sorted(listed) == sorted(words[0] for words in documented)
+    assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]
+    for words, (options, choices) in documented.items():
+        text = _help(capsys, *words)
+        assert text.startswith(f"usage: rocketmc {' '.join(words)} "), text
+        assert set(OPTION.findall(text)) - {"-h", "--help"} == options, words
+        for option, values in choices.items():
+            shown = re.search(r"\{([^}]*)\}" if option is None else re.escape(option) + r" \{([^}]*)\}", text)
+            assert shown and set(shown.group(1).split(",")) == values, (words, option)

@@ -20,7 +20,7 @@ import numpy as np
 from rocketmc.campaign import load_campaign
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
-from rocketmc.gnc import allocate
+from rocketmc.aero.canards import allocate
 from rocketmc.sim.flight import fly
 
 STEP_TIME_S = 4.0

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from rocketmc.aero import AirData
+from rocketmc.aero.canards import allocate
 from rocketmc.aero.geometry import LYNX_CANARDS
 from rocketmc.aero.model import (
     TableAero,
@@ -21,7 +22,6 @@ from rocketmc.aero.model import (
     table_coefficients,
 )
 from rocketmc.aero.sources import build_up_tables, with_axial_curve
-from rocketmc.gnc import allocate
 from rocketmc.math import Vec3
 from rocketmc.math.table import Table
 
@@ -175,10 +175,47 @@ def test_out_of_range_flag(interpolated):
     assert not inside and outside
 
 
-def test_interpolated_aero_is_a_pytree_with_static_panel_count(interpolated):
+def test_interpolated_aero_is_a_pytree_with_static_panel_count(interpolated, simplified):
+    """The models flatten to their arrays only, in field order (the tables' names static, an absent
+    power-on table no leaf), unflatten to the same model, a name is part of the structure (changing
+    it recompiles) and a value is not; the panel count is static under jit (an array shape), and
+    LinearAero's is a static int; vmap over one batched field gives each lane its own value."""
     leaves, tree = jax.tree_util.tree_flatten(interpolated)
-    assert interpolated.n_canards == 4
-    assert dataclasses.is_dataclass(jax.tree_util.tree_unflatten(tree, leaves))
+    body, panel = interpolated.body, interpolated.canard_table
+    expected = [
+        interpolated.reference_area_m2, interpolated.reference_length_m, interpolated.moment_ref_x_m,
+        *body.axes, body.values, *panel.axes, panel.values, interpolated.canard_roll_rad,
+        interpolated.canard_cp_x_m, interpolated.canard_cp_radius_m, interpolated.drag_scale, interpolated.cl0,
+    ]  # fmt: skip
+    assert len(leaves) == len(expected) and all(leaf is x for leaf, x in zip(leaves, expected))
+    assert all(isinstance(leaf, jax.Array) for leaf in leaves)
+    rebuilt = jax.tree_util.tree_unflatten(tree, leaves)
+    assert type(rebuilt) is TableAero and rebuilt.power_on_ca is None and rebuilt.n_canards == 4
+    for table, original in ((rebuilt.body, body), (rebuilt.canard_table, panel)):
+        assert (table.axis_names, table.output_names) == (original.axis_names, original.output_names)
+    renamed = dataclasses.replace(body, output_names=tuple(reversed(body.output_names)))
+    assert jax.tree_util.tree_structure(dataclasses.replace(interpolated, body=renamed)) != tree
+    assert jax.tree_util.tree_structure(dataclasses.replace(interpolated, cl0=jnp.asarray(0.5))) == tree
+    assert jax.jit(lambda aero: jnp.zeros(aero.n_canards))(interpolated).shape == (4,)
+
+    lin_leaves, lin_tree = jax.tree_util.tree_flatten(simplified)
+    assert all(isinstance(leaf, jax.Array) for leaf in lin_leaves)  # n_canards is not a leaf
+    assert type(jax.tree_util.tree_unflatten(lin_tree, lin_leaves).n_canards) is int
+    assert jax.tree_util.tree_structure(dataclasses.replace(simplified, n_canards=3)) != lin_tree
+
+    scales, offsets = jnp.array([0.8, 1.0, 1.25]), jnp.array([-0.03, 0.0, 0.02])
+
+    def ca_cl(aero):
+        c = coefficients(aero, air(alpha=0.05))
+        return c.ca, c.cl
+
+    for aero in (interpolated, simplified):  # the fixtures' drag_scale = 1, cl0 = 0
+        base = jax.jit(ca_cl)(aero)
+        batched = dataclasses.replace(aero, drag_scale=scales, cl0=offsets)
+        in_axes = dataclasses.replace(jax.tree_util.tree_map(lambda _: None, aero), drag_scale=0, cl0=0)
+        ca, cl = jax.jit(jax.vmap(ca_cl, in_axes=(in_axes,)))(batched)
+        np.testing.assert_allclose(ca, scales * base[0], rtol=1e-12)
+        np.testing.assert_allclose(cl, base[1] + offsets, rtol=0, atol=1e-15)
 
 
 def test_power_on_axial_force(interpolated, simplified):

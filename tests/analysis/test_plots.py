@@ -1,21 +1,32 @@
-"""Impact plot on a synthetic in-memory run."""
+"""Impact plot on a synthetic in-memory run: what is drawn, checked against NumPy on the same points.
+
+The expected ellipses are computed here from their definition (sample mean, sample covariance with
+ddof = 1, k² = −2 ln(1 − level) for two degrees of freedom), not with ``confidence_ellipse``, so a
+plot drawing the wrong ellipse, the wrong points or the axes swapped fails even if the ellipse
+module and the plot agree with each other.
+"""
 
 import numpy as np
 import pandas as pd
+from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
+from matplotlib.image import imread
 
-from rocketmc.analysis import Run, confidence_ellipse, plot_impacts
+from rocketmc.analysis import Run, plot_impacts
 
 N = 500
+N_FAILED = 7  # status 1; the first 5 of them also have a NaN impact
+LEVELS = (0.5, 0.95, 0.99)
+COLORS = ("tab:green", "tab:orange", "tab:red")  # plots._ELLIPSE_COLORS, level by level
 
 
-def _run():
+def _run(n=N, n_failed=N_FAILED):
     rng = np.random.default_rng(11)
-    north = rng.normal(900.0, 250.0, N)
-    east = rng.normal(300.0, 100.0, N) + 0.2 * north
-    status = np.zeros(N, dtype=np.int32)
-    status[:7] = 1
-    north[:5] = np.nan  # failed realizations: not plotted
+    north = rng.normal(900.0, 250.0, n)
+    east = rng.normal(300.0, 100.0, n) + 0.2 * north
+    status = np.zeros(n, dtype=np.int32)
+    status[:n_failed] = 1
+    north[: min(5, n_failed)] = np.nan  # failed realizations: not plotted
     outputs = pd.DataFrame({"impact_north_m": north, "impact_east_m": east, "status": status})
     return Run(
         outputs=outputs,
@@ -26,39 +37,99 @@ def _run():
     )
 
 
-def test_writes_png(tmp_path):
+def _ok_points(run):
+    ok = run.outputs["status"].to_numpy() == 0
+    return run.outputs["impact_north_m"].to_numpy()[ok], run.outputs["impact_east_m"].to_numpy()[ok]
+
+
+def _ellipse_lines(ax):
+    return [line for line in ax.lines if "ellipse" in line.get_label()]
+
+
+def test_title_labels_and_points():
+    run = _run()
+    ax = plot_impacts(run).axes[0]
+    title = f"plot-test: impact points, {N - N_FAILED} ok / {N}\n({N_FAILED} failed realizations not shown)"
+    assert ax.get_title() == title
+    assert ax.get_xlabel() == "east of pad [m]" and ax.get_ylabel() == "north of pad [m]"
+    north, east = _ok_points(run)
+    (scatter,) = ax.collections
+    offsets = np.asarray(scatter.get_offsets())
+    assert offsets.shape == (N - N_FAILED, 2)  # every ok point once, no failed one
+    np.testing.assert_array_equal(offsets, np.column_stack([east, north]))  # east on x, north on y
+    (pad,) = [line for line in ax.lines if line.get_label() == "pad"]
+    assert (pad.get_xdata()[0], pad.get_ydata()[0]) == (0.0, 0.0)
+    (mean,) = [line for line in ax.lines if line.get_label() == "mean impact"]
+    np.testing.assert_allclose([mean.get_xdata()[0], mean.get_ydata()[0]], [east.mean(), north.mean()], rtol=1e-12)
+    assert ax.get_aspect() == 1.0  # equal aspect: the ellipses are not distorted
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend[:2] == ["impacts", "pad"] and legend[-1] == "mean impact"
+
+
+def test_ellipses_have_the_sample_centre_and_semi_axes():
+    """Each drawn outline lies on (x − μ)ᵀ Σ⁻¹ (x − μ) = k² of the ok points (rtol 1e-9: the outline
+    is computed in double precision from the same mean and covariance), is closed, and its extent
+    along east and north is μ ± sqrt(k² Σ_ii) (rtol 2e-4: 200 outline points, the extreme lying
+    between two of them, cos(π/199) ≈ 1 − 1.2e-4). The label's area is π k² sqrt(det Σ)."""
+    run = _run()
+    ax = plot_impacts(run).axes[0]
+    north, east = _ok_points(run)
+    mu = np.array([east.mean(), north.mean()])
+    sigma = np.cov(np.stack([east, north]), ddof=1)
+    lines = _ellipse_lines(ax)
+    assert len(lines) == len(LEVELS)
+    for line, level, color in zip(lines, LEVELS, COLORS):
+        k2 = -2.0 * np.log(1.0 - level)
+        xy = np.column_stack([line.get_xdata(), line.get_ydata()]) - mu
+        np.testing.assert_allclose(np.einsum("ni,ij,nj->n", xy, np.linalg.inv(sigma), xy), k2, rtol=1e-9)
+        np.testing.assert_allclose(xy[0], xy[-1], rtol=0, atol=1e-9)  # closed (sin 2π is ~1e-16, not 0)
+        half_widths = np.sqrt(k2 * np.diag(sigma))
+        np.testing.assert_allclose(xy.max(axis=0), half_widths, rtol=2e-4)
+        np.testing.assert_allclose(-xy.min(axis=0), half_widths, rtol=2e-4)
+        area_km2 = np.pi * k2 * np.sqrt(np.linalg.det(sigma)) / 1e6
+        assert line.get_label() == f"{100 * level:g} % ellipse ({area_km2:.3g} km²)"
+        assert to_rgb(line.get_color()) == to_rgb(color)
+
+
+def test_all_ok_and_too_few_points():
+    """No failure line in the title when every flight is ok; with fewer than 3 ok points no ellipse
+    and no mean marker (a covariance needs 3), the points still drawn."""
+    ax = plot_impacts(_run(n_failed=0)).axes[0]
+    assert ax.get_title() == f"plot-test: impact points, {N} ok / {N}"
+    assert len(_ellipse_lines(ax)) == 3
+    ax = plot_impacts(_run(n=10, n_failed=8)).axes[0]
+    assert ax.get_title().startswith("plot-test: impact points, 2 ok / 10\n(8 failed")
+    assert np.asarray(ax.collections[0].get_offsets()).shape == (2, 2)
+    assert _ellipse_lines(ax) == [] and "mean impact" not in [line.get_label() for line in ax.lines]
+
+
+def test_png_holds_the_drawing(tmp_path):
+    """The file is the figure at 150 dpi (7.5 in square: 1125 px) and shows the three ellipses in
+    their colours, the blue points and no fourth ellipse colour. Colour matches within 0.02 per
+    channel (the PNG is 8-bit); 'present' means at least 100 pixels (a 1.8-pt outline around an
+    ellipse spans thousands)."""
     path = tmp_path / "impacts.png"
     fig = plot_impacts(_run(), path=path)
     assert isinstance(fig, Figure)
-    data = path.read_bytes()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rgb = imread(path)[..., :3]
+    assert rgb.shape == (1125, 1125, 3)
 
+    def pixels(color, tol=0.02):
+        return int(np.all(np.abs(rgb - np.array(to_rgb(color))) < tol, axis=-1).sum())
 
-def test_content_matches_ellipses():
-    run = _run()
-    fig = plot_impacts(run)
-    ax = fig.axes[0]
-    assert "plot-test" in ax.get_title() and f"{N - 7} ok / {N}" in ax.get_title()
-    assert "7 failed" in ax.get_title()
-
-    ok = run.outputs["status"].to_numpy() == 0
-    north = run.outputs["impact_north_m"].to_numpy()[ok]
-    east = run.outputs["impact_east_m"].to_numpy()[ok]
-    (scatter,) = ax.collections
-    np.testing.assert_array_equal(scatter.get_offsets(), np.column_stack([east, north]))
-
-    labels = [line.get_label() for line in ax.lines]
-    assert "pad" in labels and "mean impact" in labels
-    (line95,) = [line for line in ax.lines if line.get_label().startswith("95 %")]
-    b_north, b_east = confidence_ellipse(north, east, 0.95).boundary()
-    np.testing.assert_array_equal(line95.get_xdata(), b_east)  # east on x
-    np.testing.assert_array_equal(line95.get_ydata(), b_north)  # north on y
-    assert sum(label.endswith("km²)") for label in labels) == 3  # 50/95/99 % with area
+    for color in COLORS:
+        assert pixels(color) > 100, color
+    assert pixels("tab:purple") == 0  # plots._ELLIPSE_COLORS[3]: only three levels drawn
+    blue = (rgb[..., 2] > rgb[..., 0] + 0.2) & (rgb[..., 2] > rgb[..., 1] + 0.1)  # tab:blue points, alpha-blended
+    assert blue.sum() > 1000
 
 
 def test_draws_on_given_axes():
     fig = Figure()
     ax = fig.add_subplot()
     assert plot_impacts(_run(), ax=ax, levels=(0.9,)) is fig
-    ellipses = [line.get_label() for line in ax.lines if "ellipse" in line.get_label()]
-    assert len(ellipses) == 1 and ellipses[0].startswith("90 % ellipse")
+    assert fig.axes == [ax]
+    ellipses = _ellipse_lines(ax)
+    assert len(ellipses) == 1 and ellipses[0].get_label().startswith("90 % ellipse")
+    assert to_rgb(ellipses[0].get_color()) == to_rgb(COLORS[0])

@@ -1,5 +1,6 @@
 """Campaign validation: each kind of bad input is one line naming the field."""
 
+import re
 import tomllib
 from pathlib import Path
 
@@ -19,11 +20,82 @@ def edited(old: str, new: str) -> str:
     return NOMINAL.replace(old, new, 1)
 
 
+ROCKETS = Path(__file__).parents[2] / "src" / "rocketmc" / "data" / "rockets"
+MOTORS = ROCKETS.parent / "motors"
+# Numbers a campaign may leave out, by dotted path with list indices as '*', and their defaults.
+DEFAULTS = {
+    "rocket.nose_position_m": 0.0, "rocket.canopy_roll_damping": -5.0, "rocket.motor.thrust_scale": 1.0,
+    "rocket.motor.ignition_delay_s": 0.0, "rocket.motor.dry_mass_kg": 0.0, "rocket.motor.dry_inertia_kgm2.*": 0.0,
+    "rocket.aero.drag_scale": 1.0, "rocket.aero.cl0": 0.0, "rocket.geometry.fins.*.cant_deg": 0.0,
+    "rocket.geometry.fins.*.first_panel_deg": 0.0, "rocket.geometry.fins.*.thickness_m": 0.005,
+    "rocket.geometry.canards.cant_deg": 0.0, "rocket.geometry.canards.first_panel_deg": 0.0,
+    "rocket.parachutes.*.opening_time_s": 0.0, "environment.wind.speed_scale": 1.0,
+}  # fmt: skip
+
+
+def _flat(tree, prefix=""):
+    """{dotted path: value} of a TOML tree, list items by index ("layers.0.speed_mps")."""
+    if isinstance(tree, dict):
+        return {k: v for key, sub in tree.items() for k, v in _flat(sub, f"{prefix}{key}.").items()}
+    if isinstance(tree, list) and tree and all(isinstance(x, dict | list) for x in tree):
+        return {k: v for i, sub in enumerate(tree) for k, v in _flat(sub, f"{prefix}{i}.").items()}
+    if isinstance(tree, list):
+        return {f"{prefix}{i}": x for i, x in enumerate(tree)} or {prefix[:-1]: []}
+    return {prefix[:-1]: tree}
+
+
+def _over(base, override):
+    """``base`` with ``override`` on top, tables merged key by key, anything else replaced."""
+    merged = dict(base)
+    for key, value in override.items():
+        both_tables = isinstance(value, dict) and isinstance(base.get(key), dict)
+        merged[key] = _over(base[key], value) if both_tables else value
+    return merged
+
+
+def _number(x):
+    return isinstance(x, int | float) and not isinstance(x, bool)
+
+
 @pytest.mark.parametrize("path", sorted(CAMPAIGNS.glob("*.toml")), ids=lambda p: p.name)
 def test_shipped_campaigns_load(path):
+    """What the loader holds is what the campaign file and its preset say, read here with tomllib:
+    every number of the rocket (the preset under the file's overrides, lists replaced whole),
+    launch and environment tables is its nominal value, and the only other nominal values are the
+    schema's defaults listed in DEFAULTS; name, N, seed, site, simulation and the dispersions are the file's; a RASP
+    thrust curve is the file's points after the implicit (0, 0)."""
+    data = tomllib.loads(path.read_text())
     campaign = load_campaign(path)
-    assert campaign.config.n_realizations >= 1
-    assert set(campaign.config.dispersions) <= set(campaign.nominal)
+    config = campaign.config
+    rocket = dict(data["rocket"])
+    preset = rocket.pop("preset", None)
+    if preset is not None:
+        rocket = _over(tomllib.loads((ROCKETS / f"{preset}.toml").read_text()), rocket)
+    written = {"rocket": rocket, "launch": data["launch"], "environment": data["environment"]}
+    numbers = {k: v for k, v in _flat(written).items() if _number(v)}
+    assert {k: campaign.nominal.get(k) for k in numbers} == numbers
+    defaults = {k: v for k, v in campaign.nominal.items() if k not in numbers}
+    assert {k: DEFAULTS.get(re.sub(r"\.\d+(?=\.|$)", ".*", k)) for k in defaults} == defaults
+    loaded = _flat(config.model_dump())
+    for key, value in _flat(written).items():  # the words too: model names, files, parachute names
+        if not _number(value):
+            assert loaded[key] == value, key
+
+    assert (config.name, config.n_realizations, config.seed) == (data["name"], data["n_realizations"], data["seed"])
+    assert config.site.model_dump() == data["site"]
+    simulation = config.simulation.model_dump()
+    assert {k: simulation[k] for k in data.get("simulation", {})} == data.get("simulation", {})
+    assert list(config.dispersions) == list(data.get("dispersions", {}))
+    for key, given in data.get("dispersions", {}).items():
+        assert {k: v for k, v in config.dispersions[key].model_dump().items() if v is not None} == given, key
+        assert key in campaign.nominal
+
+    curve = MOTORS / rocket["motor"]["thrust_curve"]
+    if curve.suffix == ".eng":
+        rows = [line.split() for line in curve.read_text().splitlines() if line.strip() and not line.startswith(";")]
+        points = np.array([[float(x) for x in row] for row in rows[1:]])  # after the header line
+        np.testing.assert_array_equal(campaign.thrust_time_s, np.r_[0.0, points[:, 0]])
+        np.testing.assert_array_equal(campaign.thrust_n, np.r_[0.0, points[:, 1]])
 
 
 def test_preset_and_override():

@@ -64,7 +64,7 @@ from typing import NamedTuple
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .geometry import FinSet, RocketGeometry
+from .geometry import FinSet, RocketGeometry, nose_radius_m
 from .tables import PANEL_AXES, PANEL_COEFFS, CanardPanels, GriddedCoefficients
 
 MAX_SUBSONIC_MACH = 0.9
@@ -173,28 +173,12 @@ def slender_body_factors(count: int, tau: float, vortices_per_panel: int = 80) -
 # --- geometry helpers ---------------------------------------------------------------------------------
 
 
-def _nose_radius(kind: str, length_m: float, radius_m: float, x: np.ndarray) -> np.ndarray:
-    """Radius [m] of a nose of ``kind`` at x ∈ [0, length] from its tip."""
-    xi = np.clip(x / length_m, 0.0, 1.0)
-    if kind == "conical":
-        return radius_m * xi
-    if kind == "ogive":  # tangent ogive
-        rho = (radius_m**2 + length_m**2) / (2 * radius_m)
-        return np.sqrt(np.maximum(rho**2 - (length_m - x) ** 2, 0.0)) + radius_m - rho
-    if kind == "elliptical":
-        return radius_m * np.sqrt(np.maximum(1 - (1 - xi) ** 2, 0.0))
-    if kind == "parabolic":
-        return radius_m * (2 * xi - xi**2)
-    theta = np.arccos(1 - 2 * xi)  # Haack series: von Kármán C = 0, LV-Haack C = 1/3
-    c = 0.0 if kind == "von_karman" else 1.0 / 3.0
-    return radius_m / math.sqrt(math.pi) * np.sqrt(np.maximum(theta - np.sin(2 * theta) / 2 + c * np.sin(theta) ** 3, 0.0))
-
-
 def body_radius(geometry: RocketGeometry, x_m: np.ndarray) -> np.ndarray:
     """Radius of the body of revolution [m] at ``x_m`` from the nose tip (0 outside the body)."""
     x = np.asarray(x_m, dtype=float)
     big_r = geometry.body_radius_m
-    r = np.where(x < geometry.nose.length_m, _nose_radius(geometry.nose.kind, geometry.nose.length_m, big_r, x), big_r)
+    nose = geometry.nose
+    r = np.where(x < nose.length_m, nose_radius_m(nose.kind, nose.length_m, big_r, x), big_r)
     bt = geometry.boat_tail
     if bt is not None:
         frac = np.clip((x - bt.position_m) / bt.length_m, 0.0, 1.0)

@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from ..env.atmosphere import isa
-from .geometry import FinSet, RocketGeometry
+from .geometry import FinSet, RocketGeometry, nose_radius_m
 
 GAMMA_AIR = 1.4  # ratio of specific heats [-]
 SUTHERLAND_BETA = 1.458e-6  # Sutherland's law constant [kg/(m·s·K^0.5)] (USSA 1976)
@@ -177,24 +177,6 @@ def _cone_transonic(sin_cone, mach):
         + (-2 * t**3 + 3 * t**2) * v1
         + (t**3 - t**2) * h * d1
     )
-
-
-def nose_radius_m(kind, length_m, radius_m, x_m):
-    """Radius [m] of a nose of ``kind``, length and base radius [m] at ``x_m`` from its tip [m]
-    (OpenRocket appendix A: tangent ogive, full parabola K' = 1, Haack C = 0 and 1/3)."""
-    xi = np.asarray(x_m, dtype=float) / length_m
-    if kind == "conical":
-        return radius_m * xi
-    if kind == "ogive":  # circle of radius rho through the tip, tangent to the body at the base
-        rho = (radius_m**2 + length_m**2) / (2 * radius_m)
-        return np.sqrt(rho**2 - (length_m * (1 - xi)) ** 2) + radius_m - rho
-    if kind == "elliptical":
-        return radius_m * np.sqrt(1 - (1 - xi) ** 2)
-    if kind == "parabolic":
-        return radius_m * xi * (2 - xi)
-    c = {"von_karman": 0.0, "haack_lv": 1.0 / 3.0}[kind]
-    theta = np.arccos(1 - 2 * xi)
-    return radius_m * np.sqrt(np.maximum(theta - np.sin(2 * theta) / 2 + c * np.sin(theta) ** 3, 0.0) / np.pi)
 
 
 def nose_wetted_area_m2(kind, length_m, radius_m, samples=4001):

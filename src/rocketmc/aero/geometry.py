@@ -9,6 +9,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
+
 NOSE_KINDS = ("von_karman", "ogive", "conical", "elliptical", "parabolic", "haack_lv")
 
 
@@ -24,6 +26,27 @@ class Nose:
             raise ValueError(f"nose kind {self.kind!r} is not one of {', '.join(NOSE_KINDS)}")
         if not self.length_m > 0:
             raise ValueError(f"nose length must be > 0 m, got {self.length_m}")
+
+
+def nose_radius_m(kind: str, length_m: float, radius_m: float, x_m) -> np.ndarray:
+    """Radius [m] of a nose of ``kind``, length and base radius [m], at ``x_m`` from its tip [m] (held at
+    the tip's and the base's values outside [0, length]). OpenRocket appendix A: tangent ogive, full
+    parabola (K' = 1), half prolate spheroid, Haack series with C = 0 (von Kármán) and 1/3 (LV)."""
+    x = np.clip(np.asarray(x_m, dtype=float), 0.0, length_m)
+    xi = x / length_m
+    if kind == "conical":
+        return radius_m * xi
+    if kind == "ogive":  # circle of radius rho through the tip, tangent to the body at the base
+        rho = (radius_m**2 + length_m**2) / (2 * radius_m)
+        return np.sqrt(np.maximum(rho**2 - (length_m - x) ** 2, 0.0)) + radius_m - rho
+    if kind == "elliptical":
+        return radius_m * np.sqrt(1 - (1 - xi) ** 2)
+    if kind == "parabolic":
+        return radius_m * (2 * xi - xi**2)
+    c = {"von_karman": 0.0, "haack_lv": 1.0 / 3.0}[kind]
+    theta = np.arccos(1 - 2 * xi)
+    series = np.maximum(theta - np.sin(2 * theta) / 2 + c * np.sin(theta) ** 3, 0.0)  # π (r/R)²
+    return radius_m / math.sqrt(math.pi) * np.sqrt(series)
 
 
 @dataclasses.dataclass(frozen=True)

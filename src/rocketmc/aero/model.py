@@ -21,11 +21,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..gnc.allocation import allocate, mix
 from ..math import Vec3
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
 from .airdata import AirData
+from .canards import allocate, mix
 from .tables import BODY_COEFFS, PANEL_COEFFS, AeroTables
 
 CONTROL_OUTPUTS = ("CY", "CN", "Cl", "Cm", "Cn")
@@ -330,7 +330,7 @@ def from_virtual_commands(
     cm_alpha, cm_delta, cl0, cl_delta, cn_q, cy_r, cm_q, cl_p, drag_scale=1.0,
 ) -> LinearAero:  # fmt: skip
     """The thesis's linear model (coefficients per virtual command u = (yaw, pitch, roll, squeeze),
-    ``gnc.allocation.mix``) as a ``LinearAero`` over fin deflections δ1..δ4. Traceable: every
+    ``aero.canards.mix``) as a ``LinearAero`` over fin deflections δ1..δ4. Traceable: every
     coefficient may be a dispersed value.
 
     With u = Mδ: the control matrix is B_u·M and the quadratic form Mᵀ·diag(ca_u)·M. All damping

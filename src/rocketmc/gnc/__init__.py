@@ -1,5 +1,2 @@
-"""Guidance, navigation and control. So far: the canard mixing between fin deflections and the
-virtual (yaw, pitch, roll, squeeze) commands of the aerodynamic model."""
-
-from .allocation import allocate as allocate
-from .allocation import mix as mix
+"""Guidance, navigation and control (the closed loop, to come). The canard mixing between fin
+deflections and the virtual (yaw, pitch, roll, squeeze) commands is the airframe's: ``aero.canards``."""

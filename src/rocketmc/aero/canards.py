@@ -1,4 +1,4 @@
-"""Canard mixing: four fin deflections δ1..δ4 ↔ virtual commands u = (yaw, pitch, roll, squeeze).
+"""Canard mixing, the airframe's: four deflections δ1..δ4 ↔ virtual commands u = (yaw, pitch, roll, squeeze).
 
 The thesis's matrix (Hixos/RocketControl; ../../docs/conventions.md), rows u, columns δ:
 
@@ -7,7 +7,9 @@ The thesis's matrix (Hixos/RocketControl; ../../docs/conventions.md), rows u, co
     roll    = −(δ1 + δ2 + δ3 + δ4) / 4
     squeeze = (−δ1 + δ2 − δ3 + δ4) / 4
 
-Written on scalar components (see docs/sharp-bits.md). ``allocate`` is its exact inverse.
+Written on scalar components (see docs/sharp-bits.md). ``allocate`` is its exact inverse. It lives in
+``aero`` because it describes the airframe (the panels' numbering), not the controller: ``gnc``
+imports ``aero``, never the reverse.
 """
 
 from __future__ import annotations

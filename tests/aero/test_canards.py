@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from rocketmc.gnc import allocate, mix
+from rocketmc.aero.canards import allocate, mix
 
 THESIS_MIXING = np.array(  # rows: yaw, pitch, roll, squeeze; columns: delta 1..4 (LYNX.md)
     [[-0.5, 0, 0.5, 0], [0, 0.5, 0, -0.5], [-0.25, -0.25, -0.25, -0.25], [-0.25, 0.25, -0.25, 0.25]]
