@@ -25,12 +25,14 @@ from rocketmc.env import G0, isa
 from rocketmc.math import Vec3
 from rocketmc.math.table import Table
 from rocketmc.sim.flight import (
+    METRICS,
     Status,
     derivatives,
     flight_summary,
     fly,
     initial_state,
     mass_properties,
+    metric,
     rail_start_n,
     simulate_one,
 )
@@ -411,6 +413,35 @@ def test_attitude_stays_unit_and_state_finite(windy_flight):
     np.testing.assert_allclose(np.linalg.norm(q, axis=-1), 1.0, atol=1e-14)  # renormalised every step
     assert all(np.all(np.isfinite(np.asarray(x))) for x in jax.tree_util.tree_leaves(traj.body))
     assert not np.any(np.asarray(traj.events.non_finite))
+
+
+def test_tick_counts_control_periods(windy_flight, settings):
+    """The tick is +1 per period, also in steady descent (longer periods) and after landing; until the
+    first longer period the clock is tick·control_dt_s."""
+    _, traj, _, _ = windy_flight
+    assert traj.tick.dtype == np.int32
+    np.testing.assert_array_equal(traj.tick, np.arange(1, N_PERIODS + 1))
+    periods = np.diff(traj.t, prepend=0.0)
+    first_long = int(np.argmax(periods > settings.control_dt_s * (1 + 1e-9)))
+    assert first_long > 100  # after the climb, under canopy
+    # the clock is a float sum of the periods: rounding of ~1e-16 relative per period
+    np.testing.assert_allclose(traj.t[:first_long], traj.tick[:first_long] * settings.control_dt_s, rtol=1e-12)
+    assert traj.t[-1] > N_PERIODS * settings.control_dt_s  # the descent periods are longer
+
+
+def test_every_output_has_a_metric(windy_flight):
+    """Each output of flight_summary and the status has a unit and a meaning; the parachutes' deploy
+    times are made from their names; the units agree with the names' suffixes."""
+    p, _, s, _ = windy_flight
+    assert set(s) == set(METRICS) - {"status"} | {f"{c.name}_deploy_time_s" for c in p.rocket.parachutes}
+    suffix_units = {"_mps": "m/s", "_pa": "Pa", "_m": "m", "_s": "s"}
+    for name in [*s, "status"]:
+        unit, meaning = metric(name)
+        assert unit and meaning, name
+        assert unit == next((u for x, u in suffix_units.items() if name.endswith(x)), "1"), name
+    assert "drogue" in metric("drogue_deploy_time_s").meaning
+    with pytest.raises(KeyError):
+        metric("apogee_agl_ft")
 
 
 # --------------------------------------------------------------------------- batch and status

@@ -26,7 +26,7 @@ import numpy as np
 from .. import __version__
 from ..errors import RocketmcError
 from ..files import replacing, replacing_hdf5
-from ..sim.flight import Status, unit_of
+from ..sim.flight import Status, metric
 from .config import Campaign
 from .fingerprint import differences, fingerprint, setup
 from .runner import ChunkResult, chunking
@@ -250,9 +250,8 @@ class ResultWriter:
         if name not in g:
             fill = 0 if np.issubdtype(like.dtype, np.integer) else np.nan
             ds = g.create_dataset(name, shape=(n,), dtype=like.dtype, fillvalue=fill)
+            if group == "outputs":
+                ds.attrs["unit"], ds.attrs["description"] = metric(name)
             if name == "status":
-                ds.attrs["unit"] = "1"
                 ds.attrs["codes"] = json.dumps({str(int(s)): s.message for s in Status})
-            elif group == "outputs":
-                ds.attrs["unit"] = unit_of(name)
         return g[name]

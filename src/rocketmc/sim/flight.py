@@ -84,11 +84,16 @@ class Events:
 
 @pytree_dataclass
 class FlightState:
-    """Time [s], rigid-body state, the event record, the squared pendulum rate of the body
-    swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the descent step, and
-    the turbulence filters (None without turbulence)."""
+    """Time [s], the control-period counter, rigid-body state, the event record, the squared pendulum
+    rate of the body swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the
+    descent step, and the turbulence filters (None without turbulence).
+
+    tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A long period of
+    steady descent (``steady_descent``: up to ``settings.descent_dt_s``, the GNC idle) counts one too, so
+    ``t = tick·control_dt_s`` (up to the rounding of the summed periods) only until the first of them."""
 
     t: jnp.ndarray
+    tick: jnp.ndarray
     body: RigidBodyState
     events: Events
     canopy_stiffness: jnp.ndarray
@@ -268,7 +273,8 @@ def initial_state(p: FlightParams) -> FlightState:
         jnp.zeros_like(zero, dtype=bool),
     )  # fmt: skip
     turbulence = p.environment.turbulence
-    return FlightState(zero, body, events, zero, None if turbulence is None else initial_turbulence(turbulence))
+    filters = None if turbulence is None else initial_turbulence(turbulence)
+    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters)
 
 
 def done(state: FlightState):
@@ -296,12 +302,12 @@ def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections, noise=None
 ) -> FlightState:
     """One control period with canard deflections δ1..δn [rad] and the turbulent gust held: RK4
-    substeps of the rigid body with events (the GNC will compute ``deflections`` from the state),
-    then the turbulence filters advanced over the period with ``noise``, the period's row of
-    ``block_noise`` (None without turbulence).
+    substeps of the rigid body with events, then the turbulence filters advanced over the period
+    with ``noise``, the period's row of ``block_noise`` (None without turbulence); ``tick`` + 1.
 
     The period is ``settings.control_dt_s``; in steady descent under canopy it grows up to
-    ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with h·ω ≤ ``settings.descent_h_omega``.
+    ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with
+    h·ω ≤ ``settings.descent_h_omega``.
     Each realization keeps its own clock.
     """
     stable_period = settings.substeps * settings.descent_h_omega / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
@@ -334,7 +340,18 @@ def control_step(
     if turbulence is not None:
         airspeed = (state.body.v_n - mean_wind_n - gust).norm()
         filters = advance_turbulence(filters, scales, airspeed, period, noise)
-    return FlightState(state.t + period, body, events, stiffness, filters)
+    return FlightState(state.t + period, state.tick + 1, body, events, stiffness, filters)
+
+
+def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, noise, canard_command=None):
+    """The step of every driver (``fly_block``, ``fly``): the canard deflections of the period, then
+    ``control_step``. start_n: ``rail_start_n(p)``; canard_command: open-loop deflections, a function
+    of time [s] returning δ1..δn [rad] (None: neutral; the GNC will compute them here)."""
+    if canard_command is None:
+        deflections = jnp.zeros(p.rocket.aero.n_canards)
+    else:
+        deflections = jnp.asarray(canard_command(state.t), dtype=float)
+    return control_step(p, settings, start_n, state, deflections, noise)
 
 
 def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
@@ -361,12 +378,9 @@ def flight_done(settings: SimSettings, state: FlightState):
 def fly_block(p: FlightParams, settings: SimSettings, state: FlightState, index) -> FlightState:
     """The flight ``settings.block_steps`` control periods (block ``index`` of its flight) later,
     canards neutral."""
-    start_n, neutral = rail_start_n(p), jnp.zeros(p.rocket.aero.n_canards)
-
-    def step(s, noise):
-        return control_step(p, settings, start_n, s, neutral, noise), None
-
-    return jax.lax.scan(step, state, block_noise(p, index, settings.block_steps), settings.block_steps)[0]
+    start_n = rail_start_n(p)
+    noise = block_noise(p, index, settings.block_steps)
+    return jax.lax.scan(lambda s, n: (step(p, settings, start_n, s, n), None), state, noise, settings.block_steps)[0]
 
 
 def block_noise(p: FlightParams, index, n_periods: int):
@@ -386,16 +400,14 @@ def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=N
     each control period (default: neutral).
     """
     start_n = rail_start_n(p)
-    neutral = jnp.zeros(p.rocket.aero.n_canards)
 
-    def step(s, noise):
-        deflections = neutral if canard_command is None else jnp.asarray(canard_command(s.t), dtype=float)
-        s = control_step(p, settings, start_n, s, deflections, noise)
+    def period(s, noise):
+        s = step(p, settings, start_n, s, noise, canard_command)
         return s, s
 
     def block(s, index, length):  # the first ``length`` periods of block ``index``
         noise = block_noise(p, index, settings.block_steps)
-        return jax.lax.scan(step, s, None if noise is None else noise[:length], length)
+        return jax.lax.scan(period, s, None if noise is None else noise[:length], length)
 
     full, rest = divmod(n_periods, settings.block_steps)
     blocks = jnp.arange(full, dtype=jnp.uint32)
@@ -407,12 +419,49 @@ def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=N
     return state, trajectory
 
 
-def unit_of(name: str) -> str:
-    """Unit of a summary metric from its name's suffix."""
-    for suffix, unit in (("_mps", "m/s"), ("_pa", "Pa"), ("_m", "m"), ("_s", "s")):
-        if name.endswith(suffix):
-            return unit
-    return "1"
+class Metric(NamedTuple):
+    """An output of a flight: its unit and what it means (stored with each ``/outputs`` dataset)."""
+
+    unit: str
+    meaning: str
+
+
+METRICS: dict[str, Metric] = {
+    "apogee_agl_m": Metric("m", "altitude of the CG above the pad at apogee"),
+    "apogee_time_s": Metric("s", "time of apogee (t = 0 at rest on the rail, before ignition)"),
+    "apogee_north_m": Metric("m", "CG north of the pad at apogee"),
+    "apogee_east_m": Metric("m", "CG east of the pad at apogee"),
+    "max_mach": Metric("1", "largest Mach number of the flight"),
+    "max_dynamic_pressure_pa": Metric("Pa", "largest dynamic pressure of the flight"),
+    "max_dynamic_pressure_outside_aero_tables_pa": Metric(
+        "Pa", "largest dynamic pressure outside the aerodynamic tables' range, not under a canopy (0: never outside)"
+    ),
+    "rail_exit_time_s": Metric("s", "time the rear lug leaves the top of the rail"),
+    "rail_exit_speed_mps": Metric("m/s", "speed at rail exit"),
+    "burnout_time_s": Metric("s", "time the thrust curve ends"),
+    "burnout_altitude_agl_m": Metric("m", "altitude of the CG above the pad at burnout"),
+    "burnout_speed_mps": Metric("m/s", "speed at burnout"),
+    "impact_north_m": Metric("m", "CG north of the pad at impact (the CG back at the pad's altitude)"),
+    "impact_east_m": Metric("m", "CG east of the pad at impact"),
+    "impact_time_s": Metric("s", "time of impact"),
+    "impact_speed_mps": Metric("m/s", "speed at impact"),
+    "status": Metric("1", "outcome of the flight, a code of attrs['codes'] (0: ok)"),
+}
+"""The outputs of ``flight_summary`` by name, its status included, but the parachutes' deploy times
+(see ``metric``). Times from t = 0 at rest on the rail; speeds over ground; NaN: the event did not
+happen."""
+
+DEPLOY_TIME_SUFFIX = "_deploy_time_s"
+
+
+def metric(name: str) -> Metric:
+    """The ``Metric`` of output ``name``: from ``METRICS`` or a parachute's ``<name>_deploy_time_s``."""
+    if name in METRICS:
+        return METRICS[name]
+    if not name.endswith(DEPLOY_TIME_SUFFIX):
+        raise KeyError(name)
+    chute = name.removesuffix(DEPLOY_TIME_SUFFIX)
+    return Metric("s", f"time the {chute} parachute deploys: its trigger (apogee or its altitude) plus its delay")
 
 
 def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarray]:
@@ -442,7 +491,7 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
         "impact_speed_mps": when(ev.impact_time, ev.impact_speed),
     }
     for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
-        summary[f"{chute.name}_deploy_time_s"] = when(trigger_time, trigger_time + chute.delay_s)
+        summary[chute.name + DEPLOY_TIME_SUFFIX] = when(trigger_time, trigger_time + chute.delay_s)
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
     status = jnp.select(
