@@ -1,0 +1,137 @@
+"""Guidance (GNC.md §4): the thesis's parabolic reference, the body-rate command that turns the velocity
+onto it, the roll command to a heading and the rate-error integrators the LQI follows (GNC.md §5).
+
+Pure JAX on scalar components (``Vec3``, ``Quat``), no branches on traced values: jit and vmap as they are.
+Frames: NED world from the pad, FRD body; ``q_nb`` rotates body vectors into NED, so GNC.md's
+A(q) (NED into body) is ``q_nb.rotate_inverse``. Time ``t`` is the time since liftoff [s] (liftoff = first
+motion on the rail): the reference and the window share that clock.
+"""
+
+from __future__ import annotations
+
+import math
+
+import jax.numpy as jnp
+
+from ..env.atmosphere import G0
+from ..math.vectors import Quat, Vec3
+from ..pytree import pytree_dataclass
+
+
+@pytree_dataclass
+class Navigation:
+    """The navigation solution guidance reads, its one interface (for now the true state).
+
+    r_n: position of the centre of mass from the pad, NED [m]; v_n: inertial velocity, NED [m/s];
+    q_nb: attitude, rotates body vectors into NED; omega_b: body rates (p, q, r), FRD [rad/s].
+    """
+
+    r_n: Vec3
+    v_n: Vec3
+    q_nb: Quat
+    omega_b: Vec3
+
+
+@pytree_dataclass
+class GuidanceParams:
+    """Guidance parameters, the thesis's values (GNC.md §4) as defaults.
+
+    Reference parabola: apogee_m, the height H [m] the reference climbs after t0_s [s]; flight_path_angle_rad,
+    γ0, the reference's flight-path angle at t0 (above the horizon) [rad]; heading_rad, ψ, its azimuth
+    clockwise from north [rad] (the launch azimuth). gain: k [1/s]; rate_limit: the 2-norm limit of the
+    pitch and yaw rate command [rad/s]; min_speed: below this inertial speed [m/s] the pitch and yaw command
+    is zero. Roll: roll_gain [1/s], roll_heading_rad the azimuth [rad] the body z axis is steered toward,
+    roll_rate_limit [rad/s]. integrator_gain: k_int of e_p, e_q, e_r [-]. window_start_s, window_end_s: guidance
+    acts for window_start_s ≤ t < window_end_s [s since liftoff].
+    """
+
+    apogee_m: jnp.ndarray = 1614.0
+    t0_s: jnp.ndarray = 1.5
+    flight_path_angle_rad: jnp.ndarray = math.radians(84.0)
+    heading_rad: jnp.ndarray = math.radians(130.0)
+    gain: jnp.ndarray = 5.0
+    rate_limit: jnp.ndarray = math.radians(20.0)
+    min_speed: jnp.ndarray = 1.0
+    roll_gain: jnp.ndarray = 1.0
+    roll_heading_rad: jnp.ndarray = math.radians(90.0)
+    roll_rate_limit: jnp.ndarray = math.radians(20.0)
+    integrator_gain: Vec3 = Vec3(1.0, 12.0, 12.0)
+    window_start_s: jnp.ndarray = 1.0
+    window_end_s: jnp.ndarray = 10.0
+
+
+def guidance_active(params: GuidanceParams, t) -> jnp.ndarray:
+    """True inside the window, window_start_s ≤ t < window_end_s, t the time since liftoff [s]."""
+    return (t >= params.window_start_s) & (t < params.window_end_s)
+
+
+def reference_direction(params: GuidanceParams, nav: Navigation, t) -> Vec3:
+    """Desired velocity direction d_ref (unit, NED) of the parabolic reference at t [s since liftoff].
+
+    GNC.md §4: c1 = √(2 g0 H), v_x = c1/tan γ0, γ_ref = atan((c1 − g0 (t − t0))/v_x),
+    d_ref = (cos ψ cos γ_ref, sin ψ cos γ_ref, −sin γ_ref): a point mass climbing at c1 at t0 with horizontal
+    speed v_x along ψ, which rises H after t0. The thesis's reference depends on time only, so ``nav`` is not
+    read; it is in the signature so that a reference of the position can replace this one.
+    """
+    del nav
+    c1 = jnp.sqrt(2.0 * G0 * params.apogee_m)
+    v_x = c1 / jnp.tan(params.flight_path_angle_rad)
+    gamma = jnp.arctan((c1 - G0 * (t - params.t0_s)) / v_x)
+    cg = jnp.cos(gamma)
+    return Vec3(jnp.cos(params.heading_rad) * cg, jnp.sin(params.heading_rad) * cg, -jnp.sin(gamma))
+
+
+def _clip_norm2(y, z, limit):
+    """(y, z) scaled down to a 2-norm of at most ``limit``, direction kept."""
+    norm = jnp.sqrt(y * y + z * z)
+    scale = jnp.where(norm > limit, limit / jnp.where(norm > 0.0, norm, 1.0), 1.0)
+    return y * scale, z * scale
+
+
+def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.ndarray]:
+    """Body-rate command ω_cmd = (p, q, r), FRD [rad/s], and the tracking error χ [rad] at t [s since liftoff].
+
+    GNC.md §4, V = nav.v_n: χ = ∠(V, d_ref) ∈ [0, π], computed as atan2(‖V×d‖, V·d) (the thesis's
+    acos(V·d/‖V‖) loses digits near 0); n = V×d/‖V×d‖ (NED, 0 when V ∥ d), the axis about which a rotation by
+    +χ turns V onto d (right-handed); ω_b = k χ A(q) n. Pitch and yaw: (q, r) = ω_b's y, z components, scaled
+    together to a 2-norm of at most rate_limit, zero when ‖V‖ ≤ min_speed (ω_b's x component is dropped).
+    Roll: t_b = A(q) (cos ψ_roll, sin ψ_roll, 0), the roll error φ_e = atan2(−t_b,y, t_b,z) ∈ (−π, π] is the
+    rotation about +x_b that takes the body z axis onto t_b's lateral (y, z) part (positive p turns z_b toward
+    −y_b); p = clip(roll_gain φ_e, ±roll_rate_limit). All three are zero outside the window; χ is returned
+    at every t (the reference is defined at every t).
+    """
+    v = nav.v_n
+    d = reference_direction(params, nav, t)
+    cross = v.cross(d)
+    sin_part = cross.norm()
+    chi = jnp.arctan2(sin_part, v.dot(d))
+    axis_n = cross * (1.0 / jnp.where(sin_part > 0.0, sin_part, 1.0))
+    axis_b = nav.q_nb.rotate_inverse(axis_n)
+    fly = guidance_active(params, t)
+    steer = fly & (v.norm() > params.min_speed)
+    q_cmd, r_cmd = _clip_norm2(params.gain * chi * axis_b.y, params.gain * chi * axis_b.z, params.rate_limit)
+    ch, sh = jnp.cos(params.roll_heading_rad), jnp.sin(params.roll_heading_rad)
+    target_b = nav.q_nb.rotate_inverse(Vec3(ch, sh, jnp.zeros_like(ch)))
+    roll_error = jnp.arctan2(-target_b.y, target_b.z)
+    p_cmd = jnp.clip(params.roll_gain * roll_error, -params.roll_rate_limit, params.roll_rate_limit)
+    command = Vec3(jnp.where(fly, p_cmd, 0.0), jnp.where(steer, q_cmd, 0.0), jnp.where(steer, r_cmd, 0.0))
+    return command, chi
+
+
+def integrate_errors(
+    errors: Vec3, rate_command: Vec3, rates: Vec3, dt, active, gain: Vec3 = Vec3(1.0, 1.0, 1.0)
+) -> Vec3:
+    """Rate-error integrators (e_p, e_q, e_r) [rad] one step dt [s] on: e += k_int (ω_cmd − ω) dt while active.
+
+    GNC.md §4's e_k = e_{k−1} + k_int T (ref − ω̂), with rates ω = (p, q, r) FRD [rad/s]. The sign is
+    gnc/design.py's augmentation ė = −C x (C picks p, q, r) with the command added, ė = ω_cmd − ω, for which
+    its gains u = −K x are designed; ``gain`` is k_int per axis (design.py assumes 1; the thesis flew
+    ``GuidanceParams.integrator_gain``, 1, 12, 12). Not active: held bit for bit (the thesis resets them while
+    inactive; the same for a single window entered with e = 0, the canards commanded to zero after it).
+    """
+    step = Vec3(
+        errors.x + gain.x * (rate_command.x - rates.x) * dt,
+        errors.y + gain.y * (rate_command.y - rates.y) * dt,
+        errors.z + gain.z * (rate_command.z - rates.z) * dt,
+    )
+    return Vec3(*(jnp.where(active, s, e) for s, e in zip(step, errors)))
