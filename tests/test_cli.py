@@ -55,29 +55,6 @@ def test_report_maps(small_run, tmp_path, capsys):
     assert "\n" not in err and err.startswith("rocketmc: error:") and ".kml or .geojson" in err
 
 
-@pytest.mark.parametrize(
-    ("old", "new", "field"),
-    [
-        ("elevation_deg = 84.0", "elevation_deg = 91.0", "launch.elevation_deg"),
-        ('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = -3.0', "rocket.dry_mass_kg"),
-        ("n_realizations = 1000\n", "", "n_realizations"),
-        ("seed = 2021", "seed = 2021\ncolour = 'red'", "colour"),
-        ('preset = "lynx"', 'preset = "lynx"\naero = { tables = "missing.h5" }', "rocket.aero.tables"),
-        ('preset = "lynx"', 'preset = "lynx"\naero = { model = "fast" }', "rocket.aero.model"),
-        ("[dispersions]", '[dispersions]\n"rocket.geometry.fins.0.span_m" = { dist = "normal", std = 0.01 }',
-         "rocket.geometry.fins.0.span_m"),
-    ],
-)
-def test_bad_campaign_exit_2_and_no_file(tmp_path, capsys, old, new, field):
-    campaign = tmp_path / "bad.toml"
-    campaign.write_text((CAMPAIGNS / "lynx_nominal.toml").read_text().replace(old, new, 1))
-    out = tmp_path / "out.h5"
-    assert main(["run", str(campaign), "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and field in err, err
-    assert not list(tmp_path.glob("out.h5*"))
-
-
 def test_bad_arguments_exit_2(tmp_path, capsys):
     with pytest.raises(SystemExit) as info:
         main(["run", str(CAMPAIGNS / "lynx_nominal.toml"), "-n", "0"])

@@ -11,6 +11,7 @@ import signal
 import sys
 from pathlib import Path
 
+from . import CORES, __version__
 from .env.atmosphere import MAX_ALTITUDE_M
 from .errors import RocketmcError
 from .files import file_stem
@@ -277,8 +278,6 @@ def _bench(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
-    from . import __version__
-
     parser.add_argument("--version", action="version", version=f"rocketmc {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = commands.add_parser("run", help="fly a campaign and write its HDF5 result file")
@@ -349,9 +348,8 @@ def main(argv: list[str] | None = None) -> int:
     for name in ("n", "chunk_size", "workers"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-    if (getattr(args, "workers", None) or 0) > cores:
-        parser.error(f"--workers must be at most the {cores} core(s) of this machine (one process per core)")
+    if (getattr(args, "workers", None) or 0) > CORES:
+        parser.error(f"--workers must be at most the {CORES} core(s) of this machine (one process per core)")
     if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
         parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
                      f"[-2000, {MAX_ALTITUDE_M:.0f}] m")

@@ -27,17 +27,11 @@ from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
 from ..conftest import CAMPAIGNS
-from .test_resume import contents
+from .test_resume import assert_same, contents
 
 CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic.toml")
 N, CHUNK, SEED = 16, 2, 7  # 8 chunks of ~0.5 s on one worker core once compiled
 ARGS = ["-n", str(N), "--chunk-size", str(CHUNK), "--seed", str(SEED)]
-
-
-def assert_same(got: dict, want: dict) -> None:
-    assert got.keys() == want.keys()
-    for name in want:
-        np.testing.assert_array_equal(got[name], want[name], err_msg=name)  # bit-identical, NaNs included
 
 
 def test_two_workers_write_the_local_bits(tmp_path, monkeypatch):

@@ -25,6 +25,12 @@ def contents(path):
         return {f"{g}/{k}": ds[()] for g in ("outputs", "inputs") for k, ds in f[g].items()}, dict(f.attrs)
 
 
+def assert_same(got: dict, want: dict) -> None:
+    assert got.keys() == want.keys()
+    for name in want:
+        np.testing.assert_array_equal(got[name], want[name], err_msg=name)  # bit-identical, NaNs included
+
+
 def test_killed_run_resumes_to_the_same_bits(tmp_path, capsys):
     reference = tmp_path / "reference.h5"
     assert main(["run", CAMPAIGN, *ARGS, "--out", str(reference), "--quiet"]) == 0

@@ -306,9 +306,18 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
         ('name = "lynx_nominal"', f'name = "{"x" * 10_000}"', "name"),
         ('preset = "lynx"', 'preset = "lynx"\nmotor.thrust_curve = "binary.eng"', "rocket.motor.thrust_curve"),
         ('preset = "lynx"', 'preset = "lynx"\naero.tables = "binary.csv"', "rocket.aero.tables"),
+        ("elevation_deg = 84.0", "elevation_deg = 91.0", "launch.elevation_deg"),
+        ('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = -3.0', "rocket.dry_mass_kg"),
+        ("n_realizations = 1000\n", "", "n_realizations"),
+        ("seed = 2021", "seed = 2021\ncolour = 'red'", "colour"),
+        ('preset = "lynx"', 'preset = "lynx"\naero = { tables = "missing.h5" }', "rocket.aero.tables"),
+        ('preset = "lynx"', 'preset = "lynx"\naero = { model = "fast" }', "rocket.aero.model"),
+        ("[dispersions]", '[dispersions]\n"rocket.geometry.fins.0.span_m" = { dist = "normal", std = 0.01 }',
+         "dispersions.rocket.geometry.fins.0.span_m"),
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
-         "long-name", "binary-thrust-file", "binary-aero-csv"],
+         "long-name", "binary-thrust-file", "binary-aero-csv", "elevation-above-90", "negative-mass", "missing-n",
+         "unknown-key", "missing-table-file", "unknown-aero-model", "fixed-field-dispersed"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old

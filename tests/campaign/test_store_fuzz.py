@@ -28,6 +28,7 @@ from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
 from ..conftest import CAMPAIGNS, MOTORS
+from .test_resume import assert_same, contents
 
 ARGS = ["-n", "24", "--chunk-size", "8", "--quiet"]  # the campaign's interpolated model: loaded in ~0.1 s
 # (the simplified one is linearised anew at each load, ~5 s)
@@ -67,11 +68,6 @@ def case(flown, tmp_path):
     campaign = _campaign_dir(tmp_path / "campaign")
     shutil.copytree(partial, tmp_path / "run.h5.partial")
     return campaign, tmp_path / "run.h5"
-
-
-def contents(path):
-    with h5py.File(path) as f:
-        return {f"{g}/{k}": ds[()] for g in ("outputs", "inputs") for k, ds in f[g].items()}
 
 
 def snapshot(folder: Path) -> dict[str, bytes]:
@@ -272,10 +268,7 @@ def test_a_killed_write_left_behind_is_replaced_and_the_run_completes(case, flow
     (partial / "chunk_000001.h5").rename(partial / "chunk_000001.h5.writing")
     assert main(["run", str(campaign), *ARGS, "--out", str(out), "--resume"]) == 0
     assert not partial.exists()
-    got, want = contents(out), contents(flown[2])
-    assert got.keys() == want.keys()
-    for name in want:
-        np.testing.assert_array_equal(got[name], want[name], err_msg=name)
+    assert_same(contents(out)[0], contents(flown[2])[0])
 
 
 def test_resume_of_a_complete_run_says_so(flown, capsys, tmp_path):
@@ -334,9 +327,7 @@ def test_a_full_disk_ends_in_one_line_and_resume_completes(flown, tmp_path, caps
     assert f"{chunks_kept} chunk" in line and not out.exists()
     assert sorted(p.name for p in partial.iterdir()) == sorted(["manifest.json", *(f"chunk_{i:06d}.h5" for i in range(chunks_kept))])
     assert main([*argv, "--resume"]) == 0
-    got, want = contents(out), contents(reference)
-    for name in want:
-        np.testing.assert_array_equal(got[name], want[name], err_msg=name)
+    assert_same(contents(out)[0], contents(reference)[0])
 
 
 @pytest.mark.parametrize("out, needle", [

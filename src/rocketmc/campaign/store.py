@@ -35,6 +35,8 @@ MANIFEST = "manifest.json"
 MANIFEST_FORMAT = 2
 """Version of the partial folder's layout: 2 since the set-up fingerprint (rocketmc 0.1, issue 15)."""
 CHUNK_FILE = re.compile(r"chunk_(\d{6})\.h5")
+GROUPS = ("outputs", "inputs")
+"""The groups of a chunk file and of the result file."""
 SHOWN_DIFFERENCES = 4
 """Differing set-up fields a refusal names before '...'."""
 
@@ -81,15 +83,19 @@ class ResultWriter:
         self.fingerprint = fingerprint(self.setup)
         self.manifest = {"format": MANIFEST_FORMAT, "fingerprint": self.fingerprint, "setup": self.setup}
         self.already_complete = False
+        self._chunks: set[int] = set()  # indices of the chunks written and checked
         self._names: dict[str, set[str]] | None = None  # the datasets of every chunk, from the first checked
         if self.out.is_dir():
             raise WriteError(f"{self.out}: is a folder, expected a result file name")
         if resume:
             if not self.dir.exists() and self.out.is_file():
-                self.already_complete = self._check_complete_result()
+                self._check_complete_result()
+                self.already_complete = True
                 return
             self._check_manifest(_read_manifest(self.dir / MANIFEST))
-            self._chunks = {index: self._check_chunk(index) for index in self._listed_chunks()}
+            for index in self._listed_chunks():
+                self._read_chunk(index)
+                self._chunks.add(index)
         else:
             if self.dir.exists():
                 raise ResumeError(f"{self.dir}: a partial run is there already; resume it with --resume or delete it")
@@ -101,9 +107,9 @@ class ResultWriter:
                 if self.dir.is_dir() and not any(self.dir.iterdir()):
                     self.dir.rmdir()
                 raise WriteError(f"{e.filename or self.dir}: could not start the run ({e.strerror or e})") from None
-            self._chunks = {}
 
-    def _check_complete_result(self) -> bool:
+    def _check_complete_result(self) -> None:
+        """Resuming with no partial folder: ``out`` must be a complete result file of this set-up."""
         try:
             with h5py.File(self.out, "r") as f:
                 complete, found = bool(f.attrs.get("complete", False)), f.attrs.get("fingerprint")
@@ -114,7 +120,6 @@ class ResultWriter:
         if found != self.fingerprint:
             raise ResumeError(f"{self.out}: complete already, from another set-up (or an older rocketmc); "
                               "nothing to resume")  # fmt: skip
-        return True
 
     def _check_manifest(self, found: dict) -> None:
         if found == self.manifest:
@@ -153,15 +158,14 @@ class ResultWriter:
     def _rows(self, index: int) -> int:
         return min(self.chunk_size, self.n - index * self.chunk_size)
 
-    def _check_chunk(self, index: int) -> int:
-        """Check chunk ``index``'s file whole (every byte read, checksums verified) and of this run;
-        return its number of rows."""
+    def _read_chunk(self, index: int) -> dict[str, dict[str, np.ndarray]]:
+        """Chunk ``index``'s ``{"outputs": {name: rows}, "inputs": {...}}``, read whole (checksums
+        verified) and checked to be this run's: its fingerprint, index, first row and datasets."""
         path = self._chunk_path(index)
         try:
             with h5py.File(path, "r") as chunk:
                 attrs = {k: chunk.attrs.get(k) for k in ("fingerprint", "chunk_index", "start")}
-                names = {group: set(chunk.get(group, {})) for group in ("outputs", "inputs")}
-                lengths = {len(chunk[group][name][()]) for group in names for name in names[group]}
+                data = {group: {name: ds[()] for name, ds in chunk.get(group, {}).items()} for group in GROUPS}
         except (OSError, KeyError, TypeError, ValueError) as e:
             raise ResumeError(f"{path}: unreadable (truncated or damaged: {str(e).splitlines()[0]}); delete it and "
                               "resume to fly that chunk again") from None  # fmt: skip
@@ -170,11 +174,13 @@ class ResultWriter:
         if attrs["chunk_index"] != index or attrs["start"] != index * self.chunk_size:
             raise ResumeError(f"{path}: holds the rows of chunk {attrs['chunk_index']} (renamed or copied); "
                               "not resumed, nothing overwritten")  # fmt: skip
+        names = {group: set(data[group]) for group in GROUPS}
+        lengths = {len(values) for group in GROUPS for values in data[group].values()}
         if self._names is None:
             self._names = names
         if names != self._names or "status" not in names["outputs"] or lengths != {self._rows(index)}:
             raise ResumeError(f"{path}: its datasets differ from the run's (edited); not resumed, nothing overwritten")
-        return self._rows(index)
+        return data
 
     def completed_chunks(self) -> list[int]:
         """Indices of the chunks already written."""
@@ -186,14 +192,14 @@ class ResultWriter:
         try:
             with replacing_hdf5(path, libver="latest") as f:  # checksummed datasets stored compactly (HDF5 ≥ 1.10)
                 f.attrs.update({"fingerprint": self.fingerprint, "chunk_index": chunk_index, "start": chunk.start})
-                for group, data in (("outputs", chunk.outputs), ("inputs", chunk.inputs)):
+                for group, data in zip(GROUPS, (chunk.outputs, chunk.inputs)):
                     g = f.create_group(group)
                     for name, values in data.items():
                         g.create_dataset(name, data=values, fletcher32=True)
         except OSError as e:
             raise WriteError(f"{path}: could not write ({e.strerror or e}); the {_plural(len(self._chunks), 'chunk')} "
                              f"finished are kept in {self.dir}: free space and run the same command with --resume") from None  # fmt: skip
-        self._chunks[chunk_index] = len(chunk.outputs["status"])
+        self._chunks.add(chunk_index)
 
     def chunk_outputs(self, index: int, names) -> dict[str, np.ndarray]:
         """Some ``/outputs`` of a written chunk."""
@@ -211,8 +217,6 @@ class ResultWriter:
         missing = [index for index in needed if index not in self._chunks]
         if missing:
             raise ResumeError(f"{self.dir}: chunk(s) {', '.join(map(str, missing[:5]))} missing; resume to fly them")
-        for index in needed:
-            self._check_chunk(index)  # again: a chunk could have changed since it was written or checked
         try:
             with replacing_hdf5(self.out) as f:
                 config = self.setup["config"]
@@ -223,15 +227,14 @@ class ResultWriter:
                     "campaign_toml": self.setup["campaign_toml"],  # apart from the rest: an attribute holds ≤ 64 kB
                     "setup": json.dumps({k: v for k, v in self.setup.items() if k != "campaign_toml"}),
                 })  # fmt: skip
-                f.create_group("outputs")
-                f.create_group("inputs")
-                for index in needed:
-                    with h5py.File(self._chunk_path(index), "r") as chunk:
-                        start = index * self.chunk_size
-                        for group in ("outputs", "inputs"):
-                            for name, ds in chunk[group].items():
-                                values = ds[: max(0, min(len(ds), n - start))]
-                                self._dataset(f, group, name, values, n)[start : start + len(values)] = values
+                for group in GROUPS:
+                    f.create_group(group)
+                for index in needed:  # each chunk checked again: it could have changed since it was written
+                    start = index * self.chunk_size
+                    for group, data in self._read_chunk(index).items():
+                        for name, values in data.items():
+                            values = values[: max(0, n - start)]
+                            self._dataset(f, group, name, values, n)[start : start + len(values)] = values
                 f.attrs["complete"] = True
         except OSError as e:
             raise WriteError(f"{self.out}: could not write ({e.strerror or e}); all {_plural(len(needed), 'chunk')} are "
