@@ -17,7 +17,9 @@ CAMPAIGNS = Path(__file__).parents[1] / "campaigns"
 @pytest.fixture(scope="module")
 def small_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("run") / "ballistic.h5"
-    assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), "-n", "6", "--seed", "7", "--out", str(out)]) == 0
+    # lynx_ballistic has no [gnc]: --controller on flies it with the defaults (the thesis's closed loop)
+    args = ["-n", "6", "--seed", "7", "--controller", "on", "--out", str(out)]
+    assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), *args]) == 0
     return out
 
 
@@ -29,6 +31,10 @@ def test_run_writes_the_contract(small_run):
                      "impact_north_m", "impact_east_m", "impact_time_s", "impact_speed_mps", "status"):  # fmt: skip
             assert f["outputs"][name].shape == (6,) and "unit" in f["outputs"][name].attrs
         assert np.all(f["outputs/status"][:] == 0)
+        assert json.loads(f.attrs["setup"])["config"]["gnc"]["guidance"]["window_start_s"] == 1.0
+        active = f["outputs/control_active_time_s"]
+        assert active.attrs["unit"] == "s" and np.allclose(active[:], 9.0, atol=0.02)  # the 1-10 s window, ±1 period
+        assert np.all(f["outputs/canard_deflection_max_rad"][:] <= np.radians(10.0))
         assert json.loads(f["outputs/status"].attrs["codes"])["0"] == "ok"
         speeds = f["inputs/environment.wind.layers.1.speed_mps"][:]
         assert np.all((speeds >= 0) & (speeds <= 30)) and len(set(speeds)) == 6
@@ -81,6 +87,32 @@ def test_aero_derivatives(capsys):
     assert f"{c['CNa']:.3f}" in text and "static margin" in text
 
 
+def test_gnc_design(tmp_path, capsys):
+    """The schedule of a controlled Lynx (linear model, 4 speeds × the 3 default altitudes) as JSON, as a
+    table and as a figure; a campaign without [gnc] is one line, exit 2."""
+    campaign = tmp_path / "controlled.toml"
+    campaign.write_text((CAMPAIGNS / "lynx_nominal.toml").read_text()
+                        + '\n[rocket.aero]\nmodel = "linear"\n\n[gnc.control]\nspeeds_mps = [20.0, 100.0, 200.0, 300.0]\n')  # fmt: skip
+    png = tmp_path / "gains.png"
+    assert main(["gnc", "design", str(campaign), "--json", "--plot", str(png)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    grid = set(itertools.product((20.0, 100.0, 200.0, 300.0), (0.0, 1000.0, 2000.0)))
+    assert len(summary["points"]) == len(grid) == len({(p["speed_mps"], p["altitude_agl_m"]) for p in summary["points"]})
+    assert {(p["speed_mps"], p["altitude_agl_m"]) for p in summary["points"]} == grid
+    for p in summary["points"]:
+        assert np.shape(p["gain"]) == (3, 11) and 0.0 < p["spectral_radius"] < 1.0 and p["riccati_residual"] < 1e-9
+        assert p["altitude_msl_m"] == p["altitude_agl_m"] + 1416.0 and p["pitch"]["K_up"] == p["gain"][1][6]
+    assert summary["burnout"]["mass_kg"] == pytest.approx(18.362) and summary["r_weights"] == [100.0, 100.0, 100.0]
+    assert png.stat().st_size > 10_000
+    assert main(["gnc", "design", str(campaign)]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert "K_up" in table[3] and len(table) == 5 + len(grid)  # 3 lines of inputs, 2 of header, a row a point
+    assert main(["gnc", "design", str(CAMPAIGNS / "lynx_ballistic.toml"), "--plot", str(tmp_path / "none.png")]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("rocketmc: error:") and "no [gnc] section" in err[0], err
+    assert not (tmp_path / "none.png").exists()
+
+
 def test_until_converged_stops_by_itself(tmp_path, capsys):
     """lynx_ballistic with a 25 % target: the 95 % ellipse area's bootstrap interval is that narrow after a
     few hundred flights (its width goes as ~3.9/sqrt(N)), far below the 2000 allowed; the file keeps the
@@ -131,10 +163,12 @@ def test_help_matches_the_readme(capsys):
     subcommands, and for each the same options (both ways: an option dropped from the parser or one
     added without the README saying so fails) and the same choices where the README lists them."""
     documented = _readme_commands()
-    assert set(documented) == {("run",), ("report",), ("aero", "derivatives"), ("validate",), ("bench",)}
+    assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
+                               ("validate",), ("bench",)}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]
+    assert re.search(r"\{([a-z,]+)\}", _help(capsys, "gnc")).group(1).split(",") == ["design"]
     for words, (options, choices) in documented.items():
         text = _help(capsys, *words)
         assert text.startswith(f"usage: rocketmc {' '.join(words)} "), text

@@ -1,13 +1,16 @@
 """The landing-ellipse notebook runs top to bottom with a small N and draws its figures."""
 
+import json
 import sys
 import tomllib
 from pathlib import Path
 
 import nbformat
+import pandas as pd
 from nbclient import NotebookClient
 
 from rocketmc.analysis import load_run
+from rocketmc.sim.flight import CONTROL_METRICS
 
 REPO = Path(__file__).resolve().parents[1]
 N = 64
@@ -25,11 +28,22 @@ def test_landing_ellipses_notebook(tmp_path, monkeypatch):
     assert nb.cells[-1].outputs[0]["text"].strip() == sys.executable  # the kernel is this environment's Python
     images = [output["data"]["image/png"] for cell in nb.cells for output in cell.get("outputs", [])
               if "image/png" in output.get("data", {})]  # fmt: skip
-    assert len(images) == 3  # impacts with ellipses, the comparisons, the sensitivities
+    assert len(images) == 4  # impacts with ellipses, the comparisons, the sensitivities, controller off and on
     assert all(len(image) > 20_000 for image in images)  # base64 PNGs with content, not empty axes
     runs = {path.name: load_run(path) for path in sorted((tmp_path / "results").glob("*.h5"))}
-    assert list(runs) == [f"lynx_nominal_{variant}n{N}.h5" for variant in ("", "no_turbulence_", "simplified_")]
+    variants = ("controller_on_", "", "no_turbulence_", "simplified_")  # as written: controller off, not flown twice
+    assert list(runs) == [f"lynx_nominal_{variant}n{N}.h5" for variant in variants]
     assert all(run.attrs["n_realizations"] == N for run in runs.values())
     calm = runs[f"lynx_nominal_no_turbulence_n{N}.h5"]
     assert "turbulence" not in tomllib.loads(calm.attrs["campaign_toml"])["environment"]
     assert not any(name.startswith("environment.turbulence") for name in calm.inputs)
+
+    # Section 5: the same flights with the controller off (the campaign as written) and on.
+    off, on = runs[f"lynx_nominal_n{N}.h5"], runs[f"lynx_nominal_controller_on_n{N}.h5"]
+    assert json.loads(off.attrs["setup"])["config"]["gnc"] is None
+    assert json.loads(on.attrs["setup"])["config"]["gnc"] is not None
+    assert not set(CONTROL_METRICS) & set(off.outputs)
+    assert set(CONTROL_METRICS) <= set(on.outputs)
+    assert (on.outputs.control_active_time_s[on.ok] > 0).all()
+    assert on.attrs["seed"] == off.attrs["seed"] and len(on.outputs) == len(off.outputs) == N
+    pd.testing.assert_frame_equal(on.inputs, off.inputs)  # flight i drew the same inputs in both

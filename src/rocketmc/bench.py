@@ -5,7 +5,8 @@
 - float32 against float64: their speeds, and the distances between the impact points of the same
   realizations flown in both;
 - issue 6's ratios, timed together in one process: the vmapped batch against single flights in a
-  loop, the interpolated aerodynamics against the simplified.
+  loop, the interpolated aerodynamics against the simplified; in another, issue 16's: the closed loop
+  (perfect navigation) against the same flights with the controller off.
 
 Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
 resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
@@ -77,25 +78,48 @@ def seconds_per_flight(functions: dict[str, tuple[Callable, int]], master_key, r
     return best
 
 
+def _timed_together(campaign, builders: dict[str, tuple[Callable, tuple, int]], repeats: int) -> dict[str, float]:
+    """``seconds_per_flight`` of each ``name: (build, args, n)``'s function ``build(*args)``, the functions
+    compiled concurrently (XLA compiles outside the GIL), then timed together."""
+    with ThreadPoolExecutor() as pool:
+        compiling = {name: (pool.submit(build, *args), n) for name, (build, args, n) in builders.items()}
+        functions = {name: (f.result(), n) for name, (f, n) in compiling.items()}
+    return seconds_per_flight(functions, jax.random.key(campaign.config.seed), repeats)
+
+
+def _batch() -> int:
+    """The timed batch: ``QUEUE_PER_LANE`` flights per lane, as a chunk flies them."""
+    return batch_size(QUEUE_PER_LANE * GROUP * jax.local_device_count())
+
+
 def ratios(campaign, repeats: int = 3) -> dict:
     """Issue 6's ratios on ``campaign``: seconds per flight [s] of ``LOOP_FLIGHTS`` simplified single
-    flights in a loop and of a vmapped batch (a queue of ``QUEUE_PER_LANE`` flights per lane, as a
-    chunk flies them)
-    with each model; ``loop_over_batch`` (simplified) and ``interpolated_over_simplified`` (batches).
-    The three functions are compiled concurrently (XLA compiles outside the GIL), then timed together."""
-    simplified, interpolated = (campaign.with_overrides(aero_model=m) for m in ("simplified", "interpolated"))
-    batch = batch_size(QUEUE_PER_LANE * GROUP * jax.local_device_count())
-    with ThreadPoolExecutor() as pool:
-        compiling = {
-            "loop": (pool.submit(single_flights, simplified), LOOP_FLIGHTS),
-            "simplified": (pool.submit(compile_chunk, simplified, batch), batch),
-            "interpolated": (pool.submit(compile_chunk, interpolated, batch), batch),
-        }
-        functions = {name: (f.result(), n) for name, (f, n) in compiling.items()}
-    s = seconds_per_flight(functions, jax.random.key(campaign.config.seed), repeats)
+    flights in a loop and of a vmapped batch (``_batch``) with each model; ``loop_over_batch``
+    (simplified) and ``interpolated_over_simplified`` (batches), timed together (``_timed_together``)."""
+    simplified, interpolated = (campaign.with_overrides(aero_model=m) for m in MODELS)
+    batch = _batch()
+    s = _timed_together(campaign, {
+        "loop": (single_flights, (simplified,), LOOP_FLIGHTS),
+        "simplified": (compile_chunk, (simplified, batch), batch),
+        "interpolated": (compile_chunk, (interpolated, batch), batch),
+    }, repeats)  # fmt: skip
     return {"loop_flights": LOOP_FLIGHTS, "batch": batch, "s_per_flight": s,
             "loop_over_batch": s["loop"] / s["simplified"],
             "interpolated_over_simplified": s["interpolated"] / s["simplified"]}  # fmt: skip
+
+
+def closed_loop_ratio(campaign, repeats: int = 3) -> dict:
+    """Issue 16's ratio on ``campaign``, simplified model: seconds per flight [s] of vmapped batches
+    (``_batch``) with the controller off and on (the campaign's [gnc], or its defaults; perfect
+    navigation), timed together in their own process (a third compiled function beside the other ratios'
+    moved their timings by ~10 %); ``closed_over_open_loop``, the closed loop's cost per flight."""
+    open_loop = campaign.with_overrides(aero_model="simplified", controller=False)
+    batch = _batch()
+    s = _timed_together(campaign, {
+        "open_loop": (compile_chunk, (open_loop, batch), batch),
+        "closed_loop": (compile_chunk, (open_loop.with_overrides(controller=True), batch), batch),
+    }, repeats)  # fmt: skip
+    return {"batch": batch, "s_per_flight": s, "closed_over_open_loop": s["closed_loop"] / s["open_loop"]}
 
 
 @contextlib.contextmanager
@@ -143,6 +167,8 @@ def _measure(spec: dict) -> dict:
     campaign = load_campaign(spec["campaign"])
     if spec["kind"] == "ratios":
         result = ratios(campaign)
+    elif spec["kind"] == "closed_loop":
+        result = closed_loop_ratio(campaign)
     else:
         campaign = campaign.with_overrides(n_realizations=spec["n"], aero_model=spec["model"])
         with float32_draws() if spec["float32_draws"] else contextlib.nullcontext():
@@ -165,7 +191,7 @@ def _subprocess(precision: str, **spec) -> dict:
     done = subprocess.run(command, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
-        what = spec["kind"] if spec["kind"] == "ratios" else f"{spec['model']}, N = {spec['n']}"
+        what = spec["kind"] if spec["kind"] in ("ratios", "closed_loop") else f"{spec['model']}, N = {spec['n']}"
         raise BenchError(f"the measurement ({what}, {precision}) failed: {last}")
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -246,6 +272,8 @@ def run_benchmarks(
     r = report["ratios"] = _subprocess(precisions[0], kind="ratios", campaign=path)
     log(f"ratios ({precisions[0]}): batch {r['loop_over_batch']:.1f}x faster per flight than a loop, "
         f"interpolated {r['interpolated_over_simplified']:.2f}x the simplified")  # fmt: skip
+    c = report["closed_loop"] = _subprocess(precisions[0], kind="closed_loop", campaign=path)
+    log(f"closed loop ({precisions[0]}): {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s")
     return report
 
 
@@ -286,6 +314,13 @@ def format_report(report: dict) -> str:
         f"  timed together ({r['precision']}): a vmapped batch of {r['batch']} flies {r['loop_over_batch']:.1f}x "
         f"faster per flight than {r['loop_flights']} single flights in a loop ({1e3 * s['simplified']:.2f} against "
         f"{1e3 * s['loop']:.1f} ms, simplified); interpolated / simplified {r['interpolated_over_simplified']:.2f}x"
+    )
+    c = report["closed_loop"]
+    s = c["s_per_flight"]
+    lines.append(
+        f"  closed loop (perfect navigation, simplified, timed together): {1 / c['closed_over_open_loop']:.2f}x the "
+        f"flights/s of the same flights with the controller off ({1e3 * s['closed_loop']:.2f} against "
+        f"{1e3 * s['open_loop']:.2f} ms per flight)"
     )
     return "\n".join(lines)
 

@@ -1,5 +1,6 @@
-"""The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``aero
-derivatives`` of a rocket, ``validate`` the simulation against a real flight, ``bench`` this machine."""
+"""The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``compare`` the
+landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
+a campaign, ``validate`` the simulation against a real flight, ``bench`` this machine."""
 
 from __future__ import annotations
 
@@ -25,7 +26,9 @@ class _Parser(argparse.ArgumentParser):
 def _run(args) -> int:
     from .campaign import run_chunks
 
-    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model)
+    controller = None if args.controller is None else args.controller == "on"
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model,
+                         controller=controller)  # fmt: skip
     if args.scheduler is None and args.workers is None:
         return _fly(args, campaign, run_chunks)
     try:
@@ -122,6 +125,21 @@ def _report(args) -> int:
     return 0
 
 
+def _compare(args) -> int:
+    from .analysis import load_run
+    from .analysis.compare import compare, format_comparison
+    from .analysis.plots import plot_comparison
+
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    runs = [(file, load_run(file)) for file in args.files]
+    comparison = compare(runs)
+    print(json.dumps(comparison, indent=2, allow_nan=False) if args.json else format_comparison(comparison))
+    if plot:
+        plot_comparison(runs, path=plot)
+        print(f"wrote {plot}", file=sys.stderr)
+    return 0
+
+
 def _figure_suffixes() -> tuple[str, ...]:
     """The file suffixes matplotlib writes figures as (.png, .pdf, .svg, ...)."""
     from matplotlib.figure import Figure
@@ -146,7 +164,7 @@ def _output_file(option: str, path: str, suffixes: tuple[str, ...]) -> Path:
 
 
 def _campaign(path, **overrides):
-    """The campaign file ``path`` with the CLI's overrides (N, seed, aerodynamic model); an error
+    """The campaign file ``path`` with the CLI's overrides (N, seed, aerodynamic model, controller); an error
     names the file."""
     from .campaign import ConfigError, load_campaign
 
@@ -222,6 +240,39 @@ def _aero_derivatives(args) -> int:
     return 0
 
 
+def _gnc_design(args) -> int:
+    from .analysis.plots import plot_gains
+    from .campaign.gains import design_inputs, schedule_summary
+
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    campaign = _campaign(args.campaign, aero_model=args.aero_model)
+    if campaign.gnc_schedule is None:
+        raise RocketmcError(f"{args.campaign}: no [gnc] section, so no gains to design")
+    summary = schedule_summary(campaign, design_inputs(campaign))
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        mass, window = summary["burnout"], summary["window_estimate"]
+        print(f"{summary['campaign']}: LQI gains ({summary['aero_model']} aerodynamics), {summary['discretisation']} "
+              f"over dt {summary['dt_s']:g} s, Q = diag{tuple(summary['q_weights'])}, R = diag{tuple(summary['r_weights'])}")
+        print(f"  plant at burnout: mass {mass['mass_kg']:.3f} kg, CG x {mass['cg_x_m']:+.3f} m (body, from the "
+              f"reference point), Ixx {mass['ixx_kgm2']:.4g}, Iyy {mass['iyy_kgm2']:.4g} kg·m²; "
+              f"servo {summary['servo_bandwidth_rad_s']:.2f} rad/s")
+        print(f"  guidance window (nominal flight, point-mass estimate): {window['speed_mps'][0]:.0f} to "
+              f"{window['speed_mps'][1]:.0f} m/s, {window['altitude_agl_m'][0]:.0f} to {window['altitude_agl_m'][1]:.0f} m above the pad")
+        names = [name for gains in ("pitch", "roll") for name in summary["points"][0][gains]]
+        print(f"  {'speed':>7}{'altitude':>10}{'radius':>10}{'residual':>10}" + "".join(f"{n:>9}" for n in names))
+        print(f"  {'[m/s]':>7}{'[m AGL]':>10}")
+        for p in summary["points"]:
+            gains = [p[row][name] for row in ("pitch", "roll") for name in p[row]]
+            print(f"  {p['speed_mps']:>7g}{p['altitude_agl_m']:>10g}{p['spectral_radius']:>10.5f}"
+                  f"{p['riccati_residual']:>10.1e}" + "".join(f"{k:>9.4f}" for k in gains))
+    if plot:
+        plot_gains(summary, plot)
+        print(f"wrote {plot}", file=sys.stderr)
+    return 0
+
+
 MAX_MACH = 10.0
 """Largest Mach number ``aero derivatives`` evaluates at (tables are clamped at their edge beyond theirs)."""
 FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
@@ -294,6 +345,9 @@ def main(argv: list[str] | None = None) -> int:
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
     run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                      help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    run.add_argument("--controller", choices=("on", "off"),
+                     help="off: the same flights with the canards neutral (no [gnc]); on: the campaign's [gnc], "
+                          "or its defaults if it has none")  # fmt: skip
     cluster = run.add_mutually_exclusive_group()
     cluster.add_argument("--scheduler", metavar="ADDRESS",
                          help="fly the chunks on the Dask cluster of this scheduler (tcp://host:8786; needs "
@@ -308,6 +362,11 @@ def main(argv: list[str] | None = None) -> int:
     report.add_argument("--map", action="append", metavar="FILE",
                         help="write the impact points and ellipses around the launch site as KML (.kml) or "
                              "GeoJSON (.geojson); repeatable")  # fmt: skip
+    compare = commands.add_parser("compare", help="compare the landing dispersion of result files with the first's")
+    compare.add_argument("files", nargs="+", metavar="FILE",
+                         help="HDF5 result files, at least two; the first is the baseline")  # fmt: skip
+    compare.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    compare.add_argument("--plot", help="write the impact points and 95 %% ellipses of all files to this PNG")
     aero = commands.add_parser("aero", help="aerodynamic coefficients of a rocket")
     aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
     derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")
@@ -315,6 +374,14 @@ def main(argv: list[str] | None = None) -> int:
     derivatives.add_argument("--mach", type=float, default=0.3, help="Mach number (default 0.3)")
     derivatives.add_argument("--altitude", type=float, default=0.0, help="altitude above sea level [m] (default 0)")
     derivatives.add_argument("--json", action="store_true", help="print as JSON")
+    gnc = commands.add_parser("gnc", help="the closed loop of a campaign")
+    gnc_commands = gnc.add_subparsers(dest="gnc_command", required=True, parser_class=_Parser)
+    design = gnc_commands.add_parser("design", help="the LQI gain schedule designed at set-up, per grid point")
+    design.add_argument("campaign", help="campaign file (TOML) with a [gnc] section")
+    design.add_argument("--json", action="store_true", help="print everything as JSON, with the full gain matrices")
+    design.add_argument("--plot", help="write the main gains and spectral radius against speed to this PNG")
+    design.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
+                        help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
     validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
@@ -345,6 +412,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--n must be at least 1")
     if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
         parser.error("--until-converged must be a percentage in (0, 100]")
+    if len(getattr(args, "files", [])) == 1:
+        parser.error("compare needs at least two result files")
     for name in ("n", "chunk_size", "workers"):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
@@ -353,7 +422,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
         parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
                      f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
-    command = {"run": _run, "report": _report, "aero": _aero_derivatives, "validate": _validate, "bench": _bench}
+    command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
+               "validate": _validate, "bench": _bench}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

@@ -8,7 +8,7 @@ import jax
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import ConfigError, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign.config import ConfigError, GncConfig, campaign_from_dict, load_campaign, parse_campaign
 from rocketmc.campaign.model import nominal_params
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
@@ -61,9 +61,10 @@ def _number(x):
 def test_shipped_campaigns_load(path):
     """What the loader holds is what the campaign file and its preset say, read here with tomllib:
     every number of the rocket (the preset under the file's overrides, lists replaced whole),
-    launch and environment tables is its nominal value, and the only other nominal values are the
-    schema's defaults listed in DEFAULTS; name, N, seed, site, simulation and the dispersions are the file's; a RASP
-    thrust curve is the file's points after the implicit (0, 0)."""
+    launch, environment and gnc tables is its nominal value, and the only other nominal values are
+    the schema's defaults listed in DEFAULTS (and GncConfig's, with a [gnc] section); name, N, seed,
+    site, simulation and the dispersions are the file's; a RASP thrust curve is the file's points
+    after the implicit (0, 0)."""
     data = tomllib.loads(path.read_text())
     campaign = load_campaign(path)
     config = campaign.config
@@ -71,11 +72,12 @@ def test_shipped_campaigns_load(path):
     preset = rocket.pop("preset", None)
     if preset is not None:
         rocket = _over(tomllib.loads((ROCKETS / f"{preset}.toml").read_text()), rocket)
-    written = {"rocket": rocket, "launch": data["launch"], "environment": data["environment"]}
+    written = {"rocket": rocket, "launch": data["launch"], "environment": data["environment"], "gnc": data.get("gnc", {})}
     numbers = {k: v for k, v in _flat(written).items() if _number(v)}
     assert {k: campaign.nominal.get(k) for k in numbers} == numbers
     defaults = {k: v for k, v in campaign.nominal.items() if k not in numbers}
-    assert {k: DEFAULTS.get(re.sub(r"\.\d+(?=\.|$)", ".*", k)) for k in defaults} == defaults
+    gnc_defaults = _flat({"gnc": GncConfig().model_dump()}) if "gnc" in data else {}
+    assert {k: DEFAULTS.get(re.sub(r"\.\d+(?=\.|$)", ".*", k), gnc_defaults.get(k)) for k in defaults} == defaults
     loaded = _flat(config.model_dump())
     for key, value in _flat(written).items():  # the words too: model names, files, parachute names
         if not _number(value):

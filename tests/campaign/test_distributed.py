@@ -29,7 +29,7 @@ from rocketmc.cli import main
 from ..conftest import CAMPAIGNS
 from .test_resume import assert_same, contents
 
-CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic.toml")
+CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic_ctrl_1s.toml")  # the controller on, perfect navigation
 N, CHUNK, SEED = 16, 2, 7  # 8 chunks of ~0.5 s on one worker core once compiled
 ARGS = ["-n", str(N), "--chunk-size", str(CHUNK), "--seed", str(SEED)]
 

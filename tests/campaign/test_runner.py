@@ -3,8 +3,9 @@
 from pathlib import Path
 
 import numpy as np
+import pytest
 
-from rocketmc.campaign import load_campaign, run_chunks
+from rocketmc.campaign import parse_campaign, run_chunks
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 
@@ -16,10 +17,20 @@ def collect(campaign, chunk_size):
     return outputs, inputs
 
 
-def test_same_bits_for_any_chunk_size():
+SERVO_DISPERSIONS = """[dispersions]
+"gnc.servo.time_constant_s" = { dist = "uniform", low = 0.05, high = 0.1 }
+"gnc.servo.offset_deg.0" = { dist = "normal", std = 0.5, low = -2.0, high = 2.0 }
+"""
+
+
+@pytest.mark.parametrize("name", ["lynx_nominal", "lynx_ballistic_ctrl_1s"])
+def test_same_bits_for_any_chunk_size(name):
     # Chunks of 5 (compiled batches of 16 flights, 8 per core, a padded last chunk) against chunks of
-    # 20 (batches of 32): the same realizations with turbulence, mass, thrust and wind draws.
-    campaign = load_campaign(CAMPAIGNS / "lynx_nominal.toml").with_overrides(n_realizations=24)
+    # 20 (batches of 32): the same realizations with turbulence, mass, thrust and wind draws, open loop,
+    # and with the controller on (perfect navigation) and its servos dispersed.
+    path = CAMPAIGNS / f"{name}.toml"
+    campaign = parse_campaign(path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if "ctrl" in name else "[dispersions]\n"),
+                              path.parent).with_overrides(n_realizations=24)  # fmt: skip
     a_out, a_in = collect(campaign, 5)
     b_out, b_in = collect(campaign, 20)
     assert a_out.keys() == b_out.keys() and a_in.keys() == b_in.keys()
@@ -29,3 +40,5 @@ def test_same_bits_for_any_chunk_size():
         np.testing.assert_array_equal(a_in[name], b_in[name], err_msg=name)
     assert np.all(a_out["status"] == 0)
     assert len(np.unique(a_out["impact_north_m"])) == 24  # the realizations do differ
+    if "ctrl" in name:
+        assert len(np.unique(a_in["gnc.servo.time_constant_s"])) == 24 and np.all(a_out["control_active_time_s"] > 8.9)

@@ -9,6 +9,7 @@ import tomllib
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -21,6 +22,9 @@ from rocketmc.campaign.config import (
     MIN_CONTROL_DT_S,
     MIN_MASS_KG,
     NORMAL_REACH_STD,
+    GncConfig,
+    GuidanceConfig,
+    ServoConfig,
     flatten_numbers,
     preset_rocket,
 )
@@ -314,10 +318,20 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
         ('preset = "lynx"', 'preset = "lynx"\naero = { model = "fast" }', "rocket.aero.model"),
         ("[dispersions]", '[dispersions]\n"rocket.geometry.fins.0.span_m" = { dist = "normal", std = 0.01 }',
          "dispersions.rocket.geometry.fins.0.span_m"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[gnc.guidance]\nwindow_start_s = 5.0\nwindow_end_s = 2.0",
+         "gnc.guidance.window_end_s"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[rocket.aero]\nmodel = "linear"\n\n[gnc.control]\n'
+         "speeds_mps = [100.0, 300.0]", "gnc.control.speeds_mps"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[rocket.aero]\nmodel = "linear"\nlinear.cn_delta = 0.0\n'
+         "linear.cm_delta = 0.0\n\n[gnc]", "gnc.control"),
+        ("[dispersions]", '[dispersions]\n"gnc.control.r_weights.0" = { dist = "normal", std = 1.0 }',
+         "dispersions.gnc.control.r_weights.0"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[gnc.servo]\noffset_deg = [0.0, 0.0, -10.5, 0.0]", "gnc.servo.offset_deg"),
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
          "long-name", "binary-thrust-file", "binary-aero-csv", "elevation-above-90", "negative-mass", "missing-n",
-         "unknown-key", "missing-table-file", "unknown-aero-model", "fixed-field-dispersed"],
+         "unknown-key", "missing-table-file", "unknown-aero-model", "fixed-field-dispersed", "gnc-window-order",
+         "gnc-grid-outside-flight", "gnc-no-canard-authority", "gnc-control-dispersed", "gnc-offset-beyond-limit"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old
@@ -363,3 +377,144 @@ def test_any_number_anywhere_loads_finite_or_names_the_field(keys, value):
     else:
         numbers = {**flatten_numbers(campaign.config.model_dump()), **campaign.nominal}
         assert all(math.isfinite(x) for x in numbers.values()), (keys, value)
+
+
+GNC = {
+    **replaced(EXPANDED, "rocket.aero.model", "linear"),
+    "gnc": {"servo": {}, "guidance": {}, "control": {}},
+}
+"""The expanded nominal campaign with the thesis's closed loop on the thesis's linear model (its gains
+designed in ~0.3 s); every case below edits it once."""
+
+
+def test_gnc_base_is_valid():
+    assert campaign_from_dict(GNC, CAMPAIGNS).gnc_schedule is not None
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "message_start"),
+    [
+        ("gnc.guidance.window_end_s", 0.5,
+         "gnc.guidance.window_end_s: the window must end after it starts (window_start_s = 1.0) (got 0.5)"),
+        ("gnc.guidance.window_start_s", -1.0, "gnc.guidance.window_start_s: Input should be greater than or equal to 0"),
+        ("gnc.guidance.flight_path_angle_deg", 90.0, "gnc.guidance.flight_path_angle_deg: Input should be less than 90"),
+        ("gnc.control.q_weights", [0.0, 0.0, 0.0, -5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0],
+         "gnc.control.q_weights.3: Input should be greater than or equal to 0 (got -5.0)"),
+        ("gnc.control.q_weights", [5.0] * 10, "gnc.control.q_weights: List should have at least 11 items"),
+        ("gnc.control.r_weights", [100.0, 0.0, 100.0], "gnc.control.r_weights.1: Input should be greater than 0 (got 0.0)"),
+        ("gnc.control.speeds_mps", [20.0, 100.0, 100.0, 300.0],
+         "gnc.control.speeds_mps: the grid must be strictly increasing, got [20.0, 100.0, 100.0, 300.0]"),
+        ("gnc.control.altitudes_m", [1000.0, 0.0], "gnc.control.altitudes_m: the grid must be strictly increasing"),
+        ("gnc.control.speeds_mps", [0.0, 300.0], "gnc.control.speeds_mps.0: Input should be greater than 0"),
+        ("gnc.control.altitudes_m", [], "gnc.control.altitudes_m: List should have at least 1 item"),
+        ("gnc.control.discretisation", "tustin", "gnc.control.discretisation: Input should be 'zoh' or 'euler'"),
+        ("gnc.servo.limit_deg", 0.0, "gnc.servo.limit_deg: Input should be greater than 0 (got 0.0)"),
+        ("gnc.servo.limit_deg", 90.0, "gnc.servo.limit_deg: Input should be less than or equal to 45"),
+        ("gnc.servo.time_constant_s", 0.0, "gnc.servo.time_constant_s: Input should be greater than 0"),
+        ("gnc.servo.rate_limit_deg_s", -60.0, "gnc.servo.rate_limit_deg_s: Input should be greater than 0"),
+        ("gnc.servo.offset_deg", [0.0, 10.0, 0.0, 0.0],
+         "gnc.servo.offset_deg: each offset must be smaller in magnitude than limit_deg (10.0), got [0.0, 10.0, 0.0, 0.0]"),
+        ("gnc.servo.offset_deg", [0.0, 0.0, 0.0], "gnc.servo.offset_deg: List should have at least 4 items"),
+        ("gnc.navigation", "ekf", "gnc.navigation: Input should be 'truth'"),
+    ],
+)  # fmt: skip
+def test_bad_gnc_fields_are_refused_naming_the_field(path, value, message_start):
+    message = refusal(replaced(GNC, path, value))
+    assert message.startswith(message_start), message
+
+
+@pytest.mark.parametrize(
+    ("path", "grid", "words"),
+    [
+        ("gnc.control.speeds_mps", [100.0, 300.0],
+         "gnc.control.speeds_mps: the grid spans 100 to 300 m/s, the nominal flight 62 to 183 m/s in the guidance "
+         "window (1 to 10 s after liftoff; a point-mass estimate): extend the grid"),
+        ("gnc.control.speeds_mps", [20.0, 150.0], "the nominal flight 62 to 183 m/s"),
+        ("gnc.control.altitudes_m", [0.0, 500.0], "gnc.control.altitudes_m: the grid spans 0 to 500 m above the pad, "
+         "the nominal flight 30 to 1221 m above the pad"),
+        ("gnc.control.altitudes_m", [100.0, 2000.0], "the nominal flight 30 to 1221 m above the pad"),
+    ],
+)  # fmt: skip
+def test_a_grid_outside_the_flight_is_refused(path, grid, words):
+    """Lynx flies 62-183 m/s and 30-1221 m above the pad 1-10 s after liftoff (estimated): a grid missing
+    either end is refused."""
+    message = refusal(replaced(GNC, path, grid))
+    assert message.startswith(path) and words in message, message
+
+
+def test_one_altitude_designs_for_every_altitude():
+    """A one-point altitude grid is not checked against the flight: its gains serve every altitude."""
+    campaign = campaign_from_dict(replaced(GNC, "gnc.control.altitudes_m", [5000.0]), CAMPAIGNS)
+    assert campaign.gnc_schedule.altitudes.tolist() == [5000.0 + EXPANDED["site"]["altitude_m"]]
+
+
+def test_a_window_the_flight_misses_is_refused():
+    raw = replaced(replaced(GNC, "gnc.guidance.window_start_s", 200.0), "gnc.guidance.window_end_s", 300.0)
+    assert refusal(raw) == ("gnc.guidance.window_start_s: the nominal flight (a point-mass estimate) is not in the air "
+                            "from 200 to 300 s after liftoff")  # fmt: skip
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # scipy, on the singular pencil
+def test_a_design_point_without_control_authority_is_refused():
+    """The schema's way to an unsolvable DARE: canards with no pitch and yaw authority (CN_δ = Cm_δ = 0).
+    The pitch and yaw integrators then sit on the unit circle at every point; the first one is named."""
+    raw = replaced(replaced(GNC, "rocket.aero.linear.cn_delta", 0.0), "rocket.aero.linear.cm_delta", 0.0)
+    message = refusal(raw)
+    assert message.startswith("gnc.control: LQI design at speed 20 m/s, altitude 1416 m: no stabilising DARE"), message
+
+
+def test_gnc_needs_four_canards():
+    """The as-flown Lynx (3 fins, no canards, DATCOM table; ~5 s to linearise) cannot carry the controller."""
+    raw = {**GNC, "rocket": {"preset": "lynx_2021"}}
+    assert refusal(raw).startswith("gnc: the controller steers four canards; this rocket's aerodynamic model has 0")
+
+
+@pytest.mark.parametrize(
+    ("path", "dispersion", "message_start"),
+    [
+        ("gnc.control.r_weights.0", {"dist": "normal", "std": 1.0}, "dispersions.gnc.control.r_weights.0: fixed for the "
+         "whole campaign (guidance and the LQI gains are set once, when it loads); only the servos"),
+        ("gnc.guidance.window_start_s", {"dist": "uniform", "low": 1.0, "high": 3.5},
+         "dispersions.gnc.guidance.window_start_s: fixed for the whole campaign"),
+        ("gnc.servo.limit_deg", {"dist": "normal", "std": 2.0}, "dispersions.gnc.servo.limit_deg: draws a value -2.0 "
+         "(mean − 6·std; clip it with low) that is out of range: gnc.servo.limit_deg: Input should be greater than 0"),
+        ("gnc.servo.offset_deg.2", {"dist": "uniform", "low": -12.0, "high": 0.0},
+         "dispersions.gnc.servo.offset_deg.2: draws a value -12.0 that is out of range: gnc.servo.offset_deg: each "
+         "offset must be smaller in magnitude than limit_deg (10.0)"),
+        ("gnc.servo.rate_limit_deg_s", {"dist": "normal", "std": 10.0},
+         "dispersions.gnc.servo.rate_limit_deg_s: not a dispersible number"),  # None: no slew limit to disperse
+    ],
+)  # fmt: skip
+def test_gnc_dispersions(path, dispersion, message_start):
+    """Only the servos are dispersible, and every value they can draw is checked like any other."""
+    message = refusal({**GNC, "dispersions": {**GNC["dispersions"], path: dispersion}})
+    assert message.startswith(message_start), message
+
+
+def test_servo_dispersions_load():
+    dispersions = {"gnc.servo.time_constant_s": {"dist": "normal", "std": 0.005},
+                   "gnc.servo.offset_deg.0": {"dist": "normal", "std": 0.5}}  # fmt: skip
+    campaign = campaign_from_dict({**GNC, "dispersions": {**GNC["dispersions"], **dispersions}}, CAMPAIGNS)
+    assert campaign.nominal["gnc.servo.time_constant_s"] == 0.0769 and campaign.nominal["gnc.servo.offset_deg.0"] == 0.0
+
+
+GNC_EXPANDED = {**GNC, "dispersions": {}, "gnc": GncConfig(
+    servo=ServoConfig(rate_limit_deg_s=300.0), guidance=GuidanceConfig(heading_deg=130.0)
+).model_dump()}  # fmt: skip
+"""The [gnc] campaign with every field of its section written out (the servo's slew limit and the heading too)."""
+GNC_LEAVES = [keys for keys in leaf_paths(GNC_EXPANDED) if keys[0] == "gnc"]
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # scipy on the extreme plants of some draws (overflow, NaN)
+@settings(max_examples=40, deadline=None, database=None)  # ~0.3 s a valid campaign (its gains designed): ~10 s
+@given(keys=st.sampled_from(GNC_LEAVES), value=st.one_of(st.sampled_from(EDGE_VALUES), st.floats(), st.floats(-1e4, 1e4)))
+def test_any_gnc_number_loads_finite_or_names_the_field(keys, value):
+    """One number of the [gnc] section replaced: it loads with finite gains, or the one-line ConfigError
+    names a field of [gnc]."""
+    try:
+        campaign = campaign_from_dict(replaced(GNC_EXPANDED, keys, value), CAMPAIGNS)
+    except ConfigError as e:
+        message = str(e)
+        assert "\n" not in message and FIELD_PREFIX.match(message) and message.startswith("gnc"), (keys, message)
+    else:
+        assert np.all(np.isfinite(campaign.gnc_schedule.gains)), (keys, value)

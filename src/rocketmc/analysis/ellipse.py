@@ -126,6 +126,21 @@ def ellipse_area_m2(north, east, level: float = 0.95, axis: int = -1):
     return np.pi * chi2_scale(level) * np.sqrt(np.clip(det, 0.0, None)) * (m + 1) / m
 
 
+MIN_BOOTSTRAP_POINTS = 10
+"""Fewest impact points given bootstrap intervals (report, compare): with fewer, resamples drawing
+two or fewer distinct points (a zero area) stop being rare."""
+
+
+def percentile_interval(samples, statistic, paired: bool = True, confidence: float = 0.95, n_resamples: int = 2000,
+                        seed=0) -> tuple[float, float]:  # fmt: skip
+    """Percentile-bootstrap interval (``scipy.stats.bootstrap``) of ``statistic(*samples, axis=-1)``,
+    vectorised, at ``confidence``: each sample's last axis (its points) resampled, with the same indices
+    for all samples when ``paired``, independently otherwise."""
+    result = bootstrap(samples, statistic, paired=paired, vectorized=True, axis=-1, confidence_level=confidence,
+                       n_resamples=n_resamples, method="percentile", random_state=seed)  # fmt: skip
+    return float(result.confidence_interval.low), float(result.confidence_interval.high)
+
+
 def bootstrap_intervals(north, east, level: float = 0.95, confidence: float = 0.95, n_resamples: int = 2000, seed=0):
     """Percentile-bootstrap intervals (``scipy.stats.bootstrap``, resampling impact points in pairs) of
     the ``level`` ellipse's area [m²] and centre [m], at ``confidence``:
@@ -137,16 +152,13 @@ def bootstrap_intervals(north, east, level: float = 0.95, confidence: float = 0.
     east = np.asarray(east, dtype=float)
     finite = np.isfinite(north) & np.isfinite(east)
     north, east = north[finite], east[finite]
-    intervals = {}
-    for name, statistic in (
-        ("area_m2", lambda n, e, axis=-1: ellipse_area_m2(n, e, level, axis)),
-        ("center_north_m", lambda n, e, axis=-1: np.mean(n, axis=axis)),
-        ("center_east_m", lambda n, e, axis=-1: np.mean(e, axis=axis)),
-    ):
-        result = bootstrap((north, east), statistic, paired=True, vectorized=True, confidence_level=confidence,
-                           n_resamples=n_resamples, method="percentile", random_state=seed)  # fmt: skip
-        intervals[name] = (float(result.confidence_interval.low), float(result.confidence_interval.high))
-    return intervals
+    statistics = {
+        "area_m2": lambda n, e, axis=-1: ellipse_area_m2(n, e, level, axis),
+        "center_north_m": lambda n, e, axis=-1: np.mean(n, axis=axis),
+        "center_east_m": lambda n, e, axis=-1: np.mean(e, axis=axis),
+    }
+    return {name: percentile_interval((north, east), statistic, True, confidence, n_resamples, seed)
+            for name, statistic in statistics.items()}  # fmt: skip
 
 
 class AreaConvergence:

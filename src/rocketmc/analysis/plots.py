@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -9,10 +10,12 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..files import replacing
-from .ellipse import confidence_ellipse
+from .ellipse import Ellipse, confidence_ellipse
 from .results import Run
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")
+_RUN_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+               "tab:olive", "tab:cyan")  # fmt: skip
 
 
 def _area_label(area_m2: float) -> str:
@@ -35,35 +38,71 @@ def plot_impacts(
     ellipses are omitted when fewer than 3 ok impact points exist. Draws on ``ax`` if given
     (else on a new figure, without pyplot) and saves to ``path`` (PNG at 150 dpi) if given.
     """
-    if ax is None:
-        fig = Figure(figsize=(7.5, 7.5), layout="constrained")
-        ax = fig.add_subplot()
-    else:
-        fig = ax.figure
+    fig, ax = _figure(ax)
     north, east = run.ok_impacts()
     n_total = len(run.outputs)
     n_ok = int(run.ok.sum())
 
-    alpha = float(np.clip(300.0 / max(north.size, 1), 0.15, 0.8))
-    ax.scatter(east, north, s=6, color="tab:blue", alpha=alpha, linewidths=0, label="impacts")
+    _scatter(ax, north, east, "tab:blue", label="impacts")
     ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
     if north.size >= 3:
         for i, level in enumerate(levels):
-            e = confidence_ellipse(north, east, level)
-            b_north, b_east = e.boundary()
-            ax.plot(
-                b_east,
-                b_north,
-                color=_ELLIPSE_COLORS[i % len(_ELLIPSE_COLORS)],
-                linewidth=1.8,
-                label=f"{100 * level:g} % ellipse ({_area_label(e.area_m2)})",
-                zorder=3,
-            )
+            _ellipse(ax, confidence_ellipse(north, east, level), _ELLIPSE_COLORS[i % len(_ELLIPSE_COLORS)],
+                     f"{100 * level:g} % ellipse")  # fmt: skip
         ax.plot(east.mean(), north.mean(), "kX", markersize=9, label="mean impact", zorder=4)
 
     title = f"{run.attrs.get('campaign_name', '')}: impact points, {n_ok} ok / {n_total}"
     if n_ok < n_total:
         title += f"\n({n_total - n_ok} failed realizations not shown)"
+    _finish(fig, ax, title, path)
+    return fig
+
+
+def plot_comparison(
+    runs: Sequence[tuple[str, Run]],
+    path: str | Path | None = None,
+    ax: Axes | None = None,
+    level: float = 0.95,
+) -> Figure:
+    """Impact points of the ok realizations of several runs ``(file name, run)``, one colour each,
+    with their ``level`` ellipses labelled with campaign name, file name and area.
+
+    Axes, pad, ``ax`` and ``path`` as in :func:`plot_impacts`; each run needs 3 ok impact points.
+    """
+    fig, ax = _figure(ax)
+    for i, (file, run) in enumerate(runs):
+        color = _RUN_COLORS[i % len(_RUN_COLORS)]
+        north, east = run.ok_impacts()
+        _scatter(ax, north, east, color)
+        _ellipse(ax, confidence_ellipse(north, east, level), color,
+                 f"{run.attrs.get('campaign_name', '')} ({file}): {100 * level:g} % ellipse")  # fmt: skip
+    ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
+    _finish(fig, ax, f"Impact points and {100 * level:g} % ellipses of {len(runs)} runs", path)
+    return fig
+
+
+def _figure(ax: Axes | None) -> tuple[Figure, Axes]:
+    """``ax`` and its figure, or a new 7.5 in square figure (without pyplot) and its axes."""
+    if ax is not None:
+        return ax.figure, ax
+    fig = Figure(figsize=(7.5, 7.5), layout="constrained")
+    return fig, fig.add_subplot()
+
+
+def _scatter(ax: Axes, north: np.ndarray, east: np.ndarray, color: str, label: str | None = None) -> None:
+    """Impact points [m], east on x, fainter the more there are."""
+    alpha = float(np.clip(300.0 / max(north.size, 1), 0.15, 0.8))
+    ax.scatter(east, north, s=6, color=color, alpha=alpha, linewidths=0, label=label)
+
+
+def _ellipse(ax: Axes, ellipse: Ellipse, color: str, label: str) -> None:
+    """The outline of ``ellipse``, labelled ``label (area)``."""
+    b_north, b_east = ellipse.boundary()
+    ax.plot(b_east, b_north, color=color, linewidth=1.8, label=f"{label} ({_area_label(ellipse.area_m2)})", zorder=3)
+
+
+def _finish(fig: Figure, ax: Axes, title: str, path: str | Path | None) -> None:
+    """Title, axis labels [m], equal aspect, grid and legend; the figure saved to ``path`` if given."""
     ax.set_title(title)
     ax.set_xlabel("east of pad [m]")
     ax.set_ylabel("north of pad [m]")
@@ -73,6 +112,37 @@ def plot_impacts(
     for handle in legend.legend_handles:  # faint scatter points stay visible in the legend
         handle.set_alpha(1.0)
     if path is not None:
-        with replacing(path) as partial:  # a full disk leaves no half-written figure
-            fig.savefig(partial, dpi=150, format=Path(path).suffix.lstrip(".").lower() or "png")
+        _save(fig, path)
+
+
+def _save(fig: Figure, path: str | Path) -> None:
+    """``fig`` at 150 dpi in the format of ``path``'s suffix, written under a temporary name and renamed."""
+    with replacing(path) as partial:  # a full disk leaves no half-written figure
+        fig.savefig(partial, dpi=150, format=Path(path).suffix.lstrip(".").lower() or "png")
+
+
+def plot_gains(summary: dict, path: str | Path | None = None) -> Figure:
+    """The LQI gain schedule of ``campaign.gains.schedule_summary``: the main pitch and roll gains and the
+    closed-loop spectral radius against speed [m/s], one line per design altitude above the pad; saved
+    to ``path`` if given."""
+    points = summary["points"]
+    panels = [(row, name) for row, gains in (("pitch", ("K_w", "K_q", "K_up", "K_eq")), ("roll", ("K_p", "K_ur", "K_ep")))
+              for name in gains] + [(None, "spectral_radius")]  # fmt: skip
+    fig = Figure(figsize=(13.0, 6.5), layout="constrained")
+    axes = fig.subplots(2, 4, sharex=True).ravel()
+    for altitude in sorted({p["altitude_agl_m"] for p in points}):
+        at = [p for p in points if p["altitude_agl_m"] == altitude]
+        speeds = [p["speed_mps"] for p in at]
+        for ax, (row, name) in zip(axes, panels):
+            ax.plot(speeds, [p[name] if row is None else p[row][name] for p in at], marker=".", label=f"{altitude:g} m")
+    for ax, (row, name) in zip(axes, panels):
+        ax.set_title(name.replace("_", " ") if row is None else f"{row} {name}")
+        ax.grid(True, alpha=0.4)
+    for ax in axes[4:]:
+        ax.set_xlabel("speed [m/s]")
+    axes[0].legend(title="above the pad", fontsize="small")
+    fig.suptitle(f"{summary['campaign']}: LQI gains ({summary['aero_model']} aerodynamics, "
+                 f"{summary['discretisation']}, dt {summary['dt_s']:g} s)")  # fmt: skip
+    if path is not None:
+        _save(fig, path)
     return fig

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import RocketmcError
-from .ellipse import bootstrap_intervals, confidence_ellipse
+from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse
 
 SUMMARY_LEVELS = (0.5, 0.95, 0.99)
 """Confidence levels of the impact ellipses in :func:`summarize`."""
@@ -51,12 +51,20 @@ class Run:
             raise ResultFileError("result file has no /outputs/status dataset")
         return self.outputs["status"].to_numpy() == 0
 
-    def ok_impacts(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(north, east)`` impact points [m] of ok realizations with finite coordinates."""
-        north = self.outputs["impact_north_m"].to_numpy(dtype=float)[self.ok]
-        east = self.outputs["impact_east_m"].to_numpy(dtype=float)[self.ok]
-        finite = np.isfinite(north) & np.isfinite(east)
-        return north[finite], east[finite]
+    @property
+    def landed(self) -> np.ndarray:
+        """Boolean mask of ok realizations with finite impact coordinates."""
+        return self.ok & np.isfinite(self._impacts()).all(axis=0)
+
+    def _impacts(self) -> np.ndarray:
+        """(2, N) impact points (north, east) [m] of every realization."""
+        return self.outputs[["impact_north_m", "impact_east_m"]].to_numpy(dtype=float).T
+
+    def ok_impacts(self, where: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(north, east)`` impact points [m] of the realizations in the boolean mask ``where``
+        (default: ``landed``, the ok ones with finite coordinates)."""
+        north, east = self._impacts()[:, self.landed if where is None else where]
+        return north, east
 
 
 def _native(value):
@@ -175,7 +183,7 @@ def summarize(run: Run) -> dict:
     mean, std (ddof=1), min, p5, p50, p95, max) and ``impact_ellipses`` (``Ellipse.to_dict()``
     at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
     ``impact_ellipse_95_intervals`` (``bootstrap_intervals`` of the 95 % ellipse's area and centre;
-    None below 10 points).
+    None below ``MIN_BOOTSTRAP_POINTS``).
     """
     ok = run.ok
     status = run.outputs["status"].to_numpy()
@@ -201,7 +209,7 @@ def summarize(run: Run) -> dict:
         if north.size >= 3
         else []
     )
-    intervals = bootstrap_intervals(north, east, 0.95) if north.size >= 10 else None
+    intervals = bootstrap_intervals(north, east, 0.95) if north.size >= MIN_BOOTSTRAP_POINTS else None
     return {
         "campaign_name": run.attrs.get("campaign_name", ""),
         "seed": run.attrs.get("seed"),

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry
 from ..aero.io import load_aero
@@ -25,14 +25,18 @@ from ..aero.tables import AeroTables
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
 from ..errors import RocketmcError
+from ..gnc.design import Schedule
 from ..env.wind import POWER_LAW_FLOOR_M, read_wind_profile
 from ..math.table import Table
 
-DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment")
+DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment", "gnc")
 FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "rocket.geometry.", "rocket.aero.")
 """Numbers that define the body frame or build the aerodynamic tables once per campaign: not
 dispersible, except those of ``DISPERSIBLE_AERO``."""
 DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.linear.")
+FIXED_GNC = ("gnc.guidance.", "gnc.control.")
+"""Guidance and the gain design, set once per campaign (the gains are designed when it loads): not
+dispersible; the servos (``gnc.servo``) are."""
 ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
 
 # Physical ranges (docs/conventions.md, Campaign validation): every number is finite and within these, generous
@@ -59,6 +63,20 @@ MAX_DAMPING_COEFFICIENT = 1e5  # damping derivatives [per ω·d/(2V)]: 50 × Lyn
 MIN_CONTROL_DT_S = 1e-3  # 1 kHz, the fastest flight-computer loops; a flight is max_time_s/control_dt_s periods
 MAX_REALIZATIONS = 10**8  # ~20 float64 outputs per flight: 10⁸ flights fill ~16 GB
 MAX_NAME_LENGTH = 128  # a campaign's name is a label, printed and stored in result files
+MAX_SPEED_MPS = 10_000.0  # speeds: Mach 25 (MAX_MACH) is ~8.5 km/s
+MAX_SERVO_TIME_CONSTANT_S = 1.0  # a servo slower than 1 s cannot follow a ~10 s guidance window (Lynx: 0.077 s)
+MAX_CANARD_LIMIT_DEG = 45.0  # canards stall beyond ~20°: 45° is a unit slip, not a servo
+MAX_SERVO_RATE_DEG_S = 10_000.0  # servos slew 60-1000 °/s
+MAX_RATE_DEG_S = 3600.0  # commanded body rates: ten turns a second is no guidance
+MAX_GUIDANCE_GAIN = 1000.0  # guidance [1/s] and integrator [-] gains: 200 × the thesis's; k·T ≫ 1 oscillates
+MAX_LQ_WEIGHT = 1e12  # LQI weights: only their ratios matter, and the DARE loses accuracy beyond 1e12 apart
+DEFAULT_SPEEDS_MPS = [20.0, 30.0, 40.0, 60.0, 80.0, 100.0, 150.0, 200.0, 250.0, 300.0]
+DEFAULT_ALTITUDES_M = [0.0, 1000.0, 2000.0]
+"""The default design grid [m/s] × [m above the pad]. Lynx's guidance window (1-10 s after liftoff, at
+Roccaraso) flies 62-183 m/s and 30-1220 m (``campaign/gains.py``' estimate), from its rail exit at 21 m/s
+when it opens at liftoff; the grid adds room for dispersions and winds. Interpolated linearly, these
+points give the main gains of Lynx's designs in between within 5 % (closer where the gains vary less
+than the ~1/u of K_p below 40 m/s), and within 0.1 % between these altitudes."""
 NORMAL_REACH_STD = 6.0
 """An unclipped side of a normal dispersion is checked at mean ± 6·std: a draw beyond has a
 probability of ~1e-9."""
@@ -439,6 +457,89 @@ class SimulationConfig(_Strict):
     chunk_size: int = Field(1000, ge=1, le=MAX_REALIZATIONS, description="realizations per compiled batch")
 
 
+class ServoConfig(_Strict):
+    """The canard servos (dispersible): first order 1/(τs + 1), output clipped to ±limit_deg, optional
+    slew-rate limit, a constant offset per fin δ1..δ4 (mounting error) [deg]."""
+
+    time_constant_s: float = Field(0.0769, gt=0, le=MAX_SERVO_TIME_CONSTANT_S, description="τ [s]")
+    limit_deg: float = Field(10.0, gt=0, le=MAX_CANARD_LIMIT_DEG, description="deflection limit [deg]")
+    rate_limit_deg_s: float | None = Field(None, gt=0, le=MAX_SERVO_RATE_DEG_S, description="None: no slew limit")
+    offset_deg: list[Annotated[float, Field(ge=-MAX_CANARD_LIMIT_DEG, le=MAX_CANARD_LIMIT_DEG)]] = Field(
+        [0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4, description="per fin δ1..δ4 [deg]"
+    )
+
+    @field_validator("offset_deg")
+    @classmethod
+    def _inside_limit(cls, offsets: list[float], info: ValidationInfo) -> list[float]:
+        limit = info.data.get("limit_deg")  # absent if itself invalid
+        if limit is not None and max(abs(x) for x in offsets) >= limit:
+            raise ValueError(f"each offset must be smaller in magnitude than limit_deg ({limit}), got {offsets}")
+        return offsets
+
+
+class GuidanceConfig(_Strict):
+    """Guidance (GNC.md §4), the thesis's values as defaults; fixed per campaign. The reference parabola
+    climbs apogee_m [m] after t0_s [s] from a flight-path angle flight_path_angle_deg above the horizon,
+    toward heading_deg (clockwise from north; None: launch.azimuth_deg)."""
+
+    apogee_m: Height = 1614.0
+    t0_s: float = Field(1.5, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
+    flight_path_angle_deg: float = Field(84.0, gt=0, lt=90)
+    heading_deg: Direction | None = None
+    gain: float = Field(5.0, ge=0, le=MAX_GUIDANCE_GAIN, description="k [1/s]")
+    rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S, description="pitch/yaw command, 2-norm")
+    min_speed_mps: float = Field(1.0, ge=0, le=MAX_SPEED_MPS, description="no pitch/yaw command below")
+    roll_gain: float = Field(1.0, ge=0, le=MAX_GUIDANCE_GAIN, description="[1/s]")
+    roll_heading_deg: Direction = Field(90.0, description="azimuth the body z axis is steered toward")
+    roll_rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S)
+    integrator_gain: list[Annotated[float, Field(ge=0, le=MAX_GUIDANCE_GAIN)]] = Field(
+        [1.0, 12.0, 12.0], min_length=3, max_length=3, description="k_int of e_p, e_q, e_r [-]"
+    )
+    window_start_s: float = Field(1.0, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
+    window_end_s: float = Field(10.0, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
+
+    @field_validator("window_end_s")
+    @classmethod
+    def _after_start(cls, end: float, info: ValidationInfo) -> float:
+        start = info.data.get("window_start_s")
+        if start is not None and not start < end:
+            raise ValueError(f"the window must end after it starts (window_start_s = {start})")
+        return end
+
+
+class ControlConfig(_Strict):
+    """The LQI design (GNC.md §5); fixed per campaign. Weights on the augmented state
+    [v, w, p, q, r, u_y, u_p, u_r, e_p, e_q, e_r] and on the three virtual commands; the grid of axial
+    speed [m/s] and altitude above the pad [m] the gains are designed on (interpolated in flight)."""
+
+    q_weights: list[Annotated[float, Field(ge=0, le=MAX_LQ_WEIGHT)]] = Field(
+        [0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0], min_length=11, max_length=11
+    )
+    r_weights: list[Annotated[float, Field(gt=0, le=MAX_LQ_WEIGHT)]] = Field(
+        [100.0, 100.0, 100.0], min_length=3, max_length=3
+    )
+    speeds_mps: list[Annotated[float, Field(gt=0, le=MAX_SPEED_MPS)]] = Field(DEFAULT_SPEEDS_MPS, min_length=2)
+    altitudes_m: list[Annotated[float, Field(ge=0, le=MAX_ALTITUDE_M)]] = Field(DEFAULT_ALTITUDES_M, min_length=1)
+    discretisation: Literal["zoh", "euler"] = "zoh"
+    anti_windup: bool = True
+
+    @field_validator("speeds_mps", "altitudes_m")
+    @classmethod
+    def _increasing(cls, grid: list[float]) -> list[float]:
+        if np.any(np.diff(grid) <= 0):
+            raise ValueError(f"the grid must be strictly increasing, got {grid}")
+        return grid
+
+
+class GncConfig(_Strict):
+    """The closed loop: canard servos, guidance, LQI control; navigation "truth" (the true state)."""
+
+    navigation: Literal["truth"] = "truth"
+    servo: ServoConfig = ServoConfig()
+    guidance: GuidanceConfig = GuidanceConfig()
+    control: ControlConfig = ControlConfig()
+
+
 class CampaignConfig(_Strict):
     name: str = Field(description=f"a label of 1 to {MAX_NAME_LENGTH} printable characters on one line")
     description: str = ""
@@ -450,6 +551,7 @@ class CampaignConfig(_Strict):
     environment: EnvironmentConfig = EnvironmentConfig()
     dispersions: dict[str, Dispersion] = {}
     simulation: SimulationConfig = SimulationConfig()
+    gnc: GncConfig | None = Field(None, description="the closed loop; None: no controller, canards neutral")
 
     @field_validator("name")
     @classmethod
@@ -464,8 +566,10 @@ class Campaign:
     """A validated campaign: the config, its TOML text, the thrust curve, the nominal values of
     every dispersible number, keyed by dotted path (``"rocket.dry_mass_kg"``, ``"rocket.aero.ca0.2"``),
     the aerodynamic model with its tables (None for ``model = "linear"``, built per flight), the
-    folder its relative file names are resolved from, and the measured wind profile (altitude above
-    ground [m], speed [m/s], from-direction [rad]) when the wind model is ``profile``."""
+    folder its relative file names are resolved from, the measured wind profile (altitude above
+    ground [m], speed [m/s], from-direction [rad]) when the wind model is ``profile``, and with a
+    [gnc] section the LQI gain schedule (``campaign/gains.py``): gains over speeds [m/s] × altitudes
+    [m above mean sea level: the grid's altitudes_m plus site.altitude_m]."""
 
     config: CampaignConfig
     text: str
@@ -476,19 +580,40 @@ class Campaign:
     base_dir: Path
     wind_profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     files: dict[str, str] = dataclasses.field(default_factory=dict)
+    gnc_schedule: Schedule | None = None
 
     def with_overrides(
-        self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None
-    ) -> Campaign:
-        """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options)."""
+        self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
+        controller: bool | None = None,
+    ) -> Campaign:  # fmt: skip
+        """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
+        True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
+        (the same flights with the canards neutral)."""
         data = self.config.model_dump()
         data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
-        if aero_model is None or aero_model == self.config.rocket.aero.model:
-            return dataclasses.replace(self, config=_validate(data))
-        data["rocket"]["aero"]["model"] = aero_model
+        if aero_model is not None:
+            data["rocket"]["aero"]["model"] = aero_model
+        if controller is not None and controller != (self.config.gnc is not None):
+            data["gnc"] = {} if controller else None
+            data["dispersions"] = {k: d for k, d in data["dispersions"].items() if controller or not k.startswith("gnc.")}
         config = _validate(data)
-        return dataclasses.replace(self, config=config, aero=_aero_model(config.rocket, self.base_dir),
-                                   files=_file_digests(config, self.base_dir))  # fmt: skip
+        campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
+        new_aero = config.rocket.aero.model != self.config.rocket.aero.model
+        if new_aero:
+            campaign = dataclasses.replace(campaign, aero=_aero_model(config.rocket, self.base_dir),
+                                           files=_file_digests(config, self.base_dir))  # fmt: skip
+        if new_aero or config.gnc != self.config.gnc:
+            campaign = _with_gains(dataclasses.replace(campaign, gnc_schedule=None))
+        return campaign
+
+
+def _with_gains(campaign: Campaign) -> Campaign:
+    """``campaign`` with its LQI gain schedule designed (``campaign/gains.py``) if it has a [gnc] section."""
+    if campaign.config.gnc is None:
+        return campaign
+    from .gains import design_schedule  # gains imports campaign.model, which imports this module
+
+    return dataclasses.replace(campaign, gnc_schedule=design_schedule(campaign))
 
 
 SHOWN_INPUT_LENGTH = 60
@@ -607,6 +732,9 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
         if path.startswith(FIXED_PER_CAMPAIGN) and not path.startswith(DISPERSIBLE_AERO):
             raise ConfigError(f"{field}: fixed for the whole campaign (it defines the body frame or builds the "
                               "aerodynamic tables); disperse rocket.aero.drag_scale or rocket.aero.cl0 instead")  # fmt: skip
+        if path.startswith(FIXED_GNC):
+            raise ConfigError(f"{field}: fixed for the whole campaign (guidance and the LQI gains are set once, "
+                              "when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
         if path not in nominal:
             raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
                               f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
@@ -651,12 +779,17 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
             raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
                               f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
 
-    dump = config.model_dump()
-    nominal = {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
+    nominal = _nominal_values(config)
     _check_dispersions(config, nominal)
     aero = _aero_model(config.rocket, base_dir)
-    return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, _wind_profile(config, base_dir),
-                    _file_digests(config, base_dir))  # fmt: skip
+    return _with_gains(Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir,
+                                _wind_profile(config, base_dir), _file_digests(config, base_dir)))  # fmt: skip
+
+
+def _nominal_values(config: CampaignConfig) -> dict[str, float]:
+    """Every number of the dispersible sections by dotted path (``Campaign.nominal``)."""
+    dump = config.model_dump()
+    return {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
 
 
 def _file_digests(config: CampaignConfig, base_dir: Path) -> dict[str, str]:

@@ -2,8 +2,8 @@
 
 ``setup(campaign, chunk_size)`` is a JSON-able dict: the campaign text and its resolved
 configuration (presets merged, the CLI's N, seed and aerodynamic model applied), a digest of the
-numbers it read from files (thrust curve, aerodynamic tables, wind profile: built-in or the user's),
-the precision, the versions of rocketmc and of the numerical packages, and the chunk size.
+numbers it read from files (thrust curve, aerodynamic tables, wind profile: built-in or the user's)
+and of the LQI gains designed from them, the precision, the versions of rocketmc and of the numerical packages, and the chunk size.
 ``fingerprint(setup)`` is its SHA-256. A partial run's manifest, each of its chunk files and the
 result file carry it; ``rocketmc run --resume`` and the gather accept only chunks of the same
 fingerprint. Not covered: the kind of CPU (XLA compiles for the host's vector instructions), and
@@ -28,9 +28,10 @@ PACKAGES = ("jax", "jaxlib", "numpy", "scipy")
 
 def data_digest(campaign: Campaign) -> str:
     """SHA-256 of every array the campaign read or built from files: its thrust curve, its
-    aerodynamic model's tables and scalars, its wind profile (dtype, shape and bytes of each)."""
+    aerodynamic model's tables and scalars, its wind profile, and the LQI gain schedule designed from
+    them (dtype, shape and bytes of each)."""
     digest = hashlib.sha256()
-    tree = (campaign.thrust_time_s, campaign.thrust_n, campaign.aero, campaign.wind_profile)
+    tree = (campaign.thrust_time_s, campaign.thrust_n, campaign.aero, campaign.wind_profile, campaign.gnc_schedule)
     digest.update(str(jax.tree_util.tree_structure(tree)).encode())
     for leaf in jax.tree_util.tree_leaves(tree):
         array = np.ascontiguousarray(leaf)

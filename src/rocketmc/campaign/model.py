@@ -7,6 +7,7 @@ traced arrays for the dispersed ones), so every unit conversion below happens pe
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 
 import jax
@@ -16,7 +17,12 @@ from ..aero.model import from_virtual_commands
 from ..dynamics import Motor, Parachute
 from ..dynamics.propulsion import cumulative_impulse
 from ..dynamics.rigid_body import combine_on_axis
+from ..dynamics.servo import ServoParams
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
+from ..gnc.control import GAIN_NAMES, GncParams
+from ..gnc.guidance import GuidanceParams
+from ..math import Vec3
+from ..math.table import Table
 from ..sim.params import Environment, FlightParams, Launch, Rocket
 from .config import Campaign
 from .sampling import realization_key, stream_key
@@ -124,7 +130,41 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
         wind=_wind(campaign, v),
         turbulence=_turbulence(campaign, v, key),
     )
-    return FlightParams(rocket, launch, environment)
+    return FlightParams(rocket, launch, environment, _gnc(campaign, v))
+
+
+def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
+    """The closed loop from the campaign's [gnc] (None without it): the servos from the (possibly drawn)
+    values ``v``, guidance from the config, the gains of ``campaign.gnc_schedule``."""
+    gnc = campaign.config.gnc
+    if gnc is None:
+        return None
+    s = "gnc.servo"
+    rate_limit = gnc.servo.rate_limit_deg_s
+    servo = ServoParams(
+        time_constant_s=v[f"{s}.time_constant_s"],
+        limit_rad=jnp.deg2rad(v[f"{s}.limit_deg"]),
+        offset_rad=jnp.deg2rad(_vector(v, f"{s}.offset_deg", len(gnc.servo.offset_deg))),
+        rate_limit_rad_s=None if rate_limit is None else jnp.deg2rad(v[f"{s}.rate_limit_deg_s"]),
+    )
+    g = gnc.guidance
+    heading_deg = campaign.config.launch.azimuth_deg if g.heading_deg is None else g.heading_deg
+    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
+    guidance = GuidanceParams(
+        apogee_m=jnp.asarray(g.apogee_m), t0_s=jnp.asarray(g.t0_s), flight_path_angle_rad=rad(g.flight_path_angle_deg),
+        heading_rad=rad(heading_deg), gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s),
+        min_speed=jnp.asarray(g.min_speed_mps), roll_gain=jnp.asarray(g.roll_gain),
+        roll_heading_rad=rad(g.roll_heading_deg), roll_rate_limit=rad(g.roll_rate_limit_deg_s),
+        integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
+        window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
+    )  # fmt: skip
+    schedule = campaign.gnc_schedule
+    gains = schedule.gains.reshape(*schedule.gains.shape[:2], -1)  # (speed, altitude, 33)
+    if schedule.altitudes.size > 1:
+        table = Table.from_numpy((schedule.speeds, schedule.altitudes), gains, ("speed", "altitude"), GAIN_NAMES)
+    else:
+        table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
+    return GncParams(servo, guidance, table, gnc.control.anti_windup)
 
 
 def _wind(campaign: Campaign, v: Mapping):

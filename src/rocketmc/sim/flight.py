@@ -19,10 +19,12 @@ from ..aero import aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
+from ..dynamics.servo import deflection_at, end_of_period
 from ..env import (
     G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, isa, turbulence_noise, turbulence_scales,
 )  # fmt: skip
 from ..env.atmosphere import MAX_ALTITUDE_M
+from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, truth
 from ..math import Quat, Vec3, rk4_step
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
@@ -86,7 +88,8 @@ class Events:
 class FlightState:
     """Time [s], the control-period counter, rigid-body state, the event record, the squared pendulum
     rate of the body swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the
-    descent step, and the turbulence filters (None without turbulence).
+    descent step, the turbulence filters (None without turbulence) and the closed loop's state (None
+    without a controller).
 
     tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A long period of
     steady descent (``steady_descent``: up to ``settings.descent_dt_s``, the GNC idle) counts one too, so
@@ -98,6 +101,7 @@ class FlightState:
     events: Events
     canopy_stiffness: jnp.ndarray
     turbulence: TurbulenceState | None
+    gnc: GncState | None = None
 
 
 class Diagnostics(NamedTuple):
@@ -274,7 +278,8 @@ def initial_state(p: FlightParams) -> FlightState:
     )  # fmt: skip
     turbulence = p.environment.turbulence
     filters = None if turbulence is None else initial_turbulence(turbulence)
-    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters)
+    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero)
+    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters, gnc)
 
 
 def done(state: FlightState):
@@ -298,21 +303,26 @@ def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
     return any_open & ~transient
 
 
+def control_period(p: FlightParams, settings: SimSettings, state: FlightState):
+    """The period starting at ``state`` [s]: ``settings.control_dt_s``; in steady descent under canopy
+    it grows up to ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with
+    h·ω ≤ ``settings.descent_h_omega``. Each realization keeps its own clock."""
+    stable_period = settings.substeps * settings.descent_h_omega / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
+    descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
+    return jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
+
+
 def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections, noise=None
 ) -> FlightState:
-    """One control period with canard deflections δ1..δn [rad] and the turbulent gust held: RK4
-    substeps of the rigid body with events, then the turbulence filters advanced over the period
-    with ``noise``, the period's row of ``block_noise`` (None without turbulence); ``tick`` + 1.
+    """One control period (``control_period``) with the turbulent gust held: RK4 substeps of the rigid
+    body with events, then the turbulence filters advanced over the period with ``noise``, the
+    period's row of ``block_noise`` (None without turbulence); ``tick`` + 1.
 
-    The period is ``settings.control_dt_s``; in steady descent under canopy it grows up to
-    ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with
-    h·ω ≤ ``settings.descent_h_omega``.
-    Each realization keeps its own clock.
+    deflections: the canard deflections δ1..δn [rad] as a function of the time t [s] inside the
+    period (held, or the servos' response evaluated at each RK4 stage).
     """
-    stable_period = settings.substeps * settings.descent_h_omega / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
-    descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
-    period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
+    period = control_period(p, settings, state)
     h = period / settings.substeps
     turbulence = p.environment.turbulence
     altitude = -state.body.r_n.z
@@ -324,7 +334,7 @@ def control_step(
 
     def substep(carry, _):
         t0, body0, events, _ = carry
-        rhs = lambda t, y: derivatives(t, y, p, deflections, gust, events)  # noqa: E731
+        rhs = lambda t, y: derivatives(t, y, p, deflections(t), gust, events)  # noqa: E731
         body1, diag = rk4_step(rhs, t0, body0, h)
         body1 = normalize_attitude(body1)
         events = update_events(p, start_n, events, t0, h, body0, body1, diag)
@@ -340,18 +350,27 @@ def control_step(
     if turbulence is not None:
         airspeed = (state.body.v_n - mean_wind_n - gust).norm()
         filters = advance_turbulence(filters, scales, airspeed, period, noise)
-    return FlightState(state.t + period, state.tick + 1, body, events, stiffness, filters)
+    return FlightState(state.t + period, state.tick + 1, body, events, stiffness, filters, state.gnc)
 
 
 def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, noise, canard_command=None):
     """The step of every driver (``fly_block``, ``fly``): the canard deflections of the period, then
     ``control_step``. start_n: ``rail_start_n(p)``; canard_command: open-loop deflections, a function
-    of time [s] returning δ1..δn [rad] (None: neutral; the GNC will compute them here)."""
-    if canard_command is None:
-        deflections = jnp.zeros(p.rocket.aero.n_canards)
-    else:
-        deflections = jnp.asarray(canard_command(state.t), dtype=float)
-    return control_step(p, settings, start_n, state, deflections, noise)
+    of time [s] returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when
+    ``p.gnc`` is set: guidance and control at the period start, the servos' response inside it)."""
+    if p.gnc is None:
+        held = jnp.zeros(p.rocket.aero.n_canards) if canard_command is None else canard_command(state.t)
+        held = jnp.asarray(held, dtype=float)
+        return control_step(p, settings, start_n, state, lambda t: held, noise)
+    if canard_command is not None:
+        raise ValueError("canard_command flies open loop: it needs a flight without a controller (p.gnc None)")
+    servo_params, t0 = p.gnc.servo, state.t
+    canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in state.events.chute_trigger_times], False)
+    altitude_msl = p.environment.site_altitude_m - state.body.r_n.z
+    gnc = gnc_step(p.gnc, state.gnc, truth(state.body), t0, settings.control_dt_s, altitude_msl, canopy)
+    servo = end_of_period(servo_params, gnc.servo, control_period(p, settings, state))
+    state = control_step(p, settings, start_n, state, lambda t: deflection_at(servo_params, gnc.servo, t - t0), noise)
+    return dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
 
 
 def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
@@ -451,13 +470,22 @@ METRICS: dict[str, Metric] = {
 (see ``metric``). Times from t = 0 at rest on the rail; speeds over ground; NaN: the event did not
 happen."""
 
+CONTROL_METRICS: dict[str, Metric] = {
+    "control_active_time_s": Metric("s", "time the controller was active: inside the guidance window, no parachute triggered"),
+    "tracking_error_rms_rad": Metric("rad", "RMS over the active time of χ, the angle from the velocity to the reference direction"),
+    "canard_deflection_rms_rad": Metric("rad", "RMS over the active time and the fins of the canard deflections"),
+    "canard_deflection_max_rad": Metric("rad", "largest canard deflection of any fin in the flight"),
+    "canard_saturated_fraction": Metric("1", "fraction of the active time with a fin command clipped at the servo limit"),
+}
+"""The outputs a flight with a controller adds (``gnc.control.control_summary``); NaN where it never acted."""
+
 DEPLOY_TIME_SUFFIX = "_deploy_time_s"
 
 
 def metric(name: str) -> Metric:
     """The ``Metric`` of output ``name``: from ``METRICS`` or a parachute's ``<name>_deploy_time_s``."""
-    if name in METRICS:
-        return METRICS[name]
+    if name in METRICS or name in CONTROL_METRICS:
+        return {**METRICS, **CONTROL_METRICS}[name]
     if not name.endswith(DEPLOY_TIME_SUFFIX):
         raise KeyError(name)
     chute = name.removesuffix(DEPLOY_TIME_SUFFIX)
@@ -492,6 +520,8 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
     }
     for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
         summary[chute.name + DEPLOY_TIME_SUFFIX] = when(trigger_time, trigger_time + chute.delay_s)
+    if state.gnc is not None:
+        summary.update(control_summary(state.gnc))
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
     status = jnp.select(

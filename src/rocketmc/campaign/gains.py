@@ -1,0 +1,237 @@
+"""The LQI gain schedule of a campaign with a ``[gnc]`` section (GNC.md §5), designed once on the host
+when the campaign loads (``config.campaign_from_dict``, ``Campaign.with_overrides``).
+
+Each grid point (axial speed u [m/s], altitude) is ``gnc.design``'s linear plant built from the
+campaign's own aerodynamic model at α = β = δ = 0 (its simplified form: the linear model as given,
+the simplified table, or ``simplify`` of the interpolated tables) and from the nominal rocket at
+burnout: the coast, where most of the guidance window lies. Before the design, the grid is checked
+against a point-mass estimate of the nominal flight inside the guidance window.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from ..aero.model import LinearAero, linear_derivatives, simplify
+from ..dynamics.propulsion import propellant_mass, thrust
+from ..dynamics.rigid_body import MassProperties
+from ..env.atmosphere import G0, isa
+from ..gnc.design import PlantPoint, Schedule, gain_schedule
+from ..sim.flight import mass_properties
+from ..sim.params import FlightParams
+from .config import Campaign, ConfigError
+from .model import nominal_params
+
+ESTIMATE_DT_S = 0.01
+"""Step of the point-mass estimate [s]: Lynx's window speeds are within 0.3 % of a step ten times smaller."""
+ESTIMATE_HEIGHTS_M = np.linspace(0.0, 50_000.0, 1001)
+"""Heights above the pad [m] the estimate tabulates the ISA on: every 50 m to 50 km (the ISA ends at 47 km)."""
+
+
+class DesignInputs(NamedTuple):
+    """What the gains are designed from: aero, the campaign's model in its simplified form; mass, the
+    nominal rocket at burnout (mass [kg], CG body x [m], inertia [kg·m²]); omega_a, the servo bandwidth
+    1/τ [rad/s]; speeds [m/s] and altitudes_agl [m above the pad], the nominal flight's range inside the
+    guidance window (point-mass estimate, ``window_envelope``)."""
+
+    aero: LinearAero
+    mass: MassProperties
+    omega_a: float
+    speeds: tuple[float, float]
+    altitudes_agl: tuple[float, float]
+
+
+def design_inputs(campaign: Campaign) -> DesignInputs:
+    """The ``DesignInputs`` of a campaign with a ``[gnc]`` section; ConfigError if its rocket has no
+    four canards or its nominal flight is not in the air during the guidance window."""
+    # The rocket and flight without the controller: its FlightParams need no gains.
+    params = nominal_params(dataclasses.replace(campaign, config=campaign.config.model_copy(update={"gnc": None})))
+    aero = params.rocket.aero
+    aero = aero if isinstance(aero, LinearAero) else simplify(aero)
+    if aero.n_canards != 4:
+        raise ConfigError(f"gnc: the controller steers four canards; this rocket's aerodynamic model has "
+                          f"{aero.n_canards} (rocket.geometry.canards)")  # fmt: skip
+    motor = params.rocket.motor
+    times = jnp.arange(0.0, float(motor.ignition_time_s + motor.burn_time_s), ESTIMATE_DT_S)
+    mass, *arrays = _nominal_arrays(params, times, jnp.asarray(ESTIMATE_HEIGHTS_M))
+    guidance = campaign.config.gnc.guidance
+    speeds, altitudes = window_envelope(params, aero, *map(np.asarray, arrays), guidance.window_start_s,
+                                        guidance.window_end_s)  # fmt: skip
+    return DesignInputs(aero, mass, 1.0 / campaign.config.gnc.servo.time_constant_s, speeds, altitudes)
+
+
+@jax.jit
+def _nominal_arrays(params: FlightParams, times, heights):
+    """The nominal rocket's mass properties at burnout; thrust [N] and propellant mass [kg] at simulation
+    ``times`` [s]; ISA density [kg/m³] and speed of sound [m/s] at ``heights`` above the pad [m]. One
+    compilation (eagerly, XLA compiles each operation apart: seconds in a fresh process)."""
+    motor = params.rocket.motor
+    air = isa(params.environment.site_altitude_m + heights)
+    return (mass_properties(params, motor.ignition_time_s + motor.burn_time_s), thrust(motor, times),
+            propellant_mass(motor, times), air.density, air.speed_of_sound)  # fmt: skip
+
+
+def plant_point(
+    aero: LinearAero, mass: MassProperties, speed: float, altitude_msl: float, omega_a: float
+) -> PlantPoint:
+    """GNC.md §5's plant at axial speed ``speed`` [m/s] and ``altitude_msl`` [m]: the coefficients of
+    ``aero`` at that Mach number and altitude (ISA), the moments moved from its reference to the CG of
+    ``mass``, the force damping halved to PlantPoint's per ω·d/V."""
+    air = isa(altitude_msl)
+    c = linear_derivatives(aero, speed / float(air.speed_of_sound), altitude_msl)
+    d = float(aero.reference_length_m)
+    # About the CG: M_cg = M_ref + (a, 0, 0) × q̄S(−CA, CY, −CN), a = x_ref − x_cg (forward), so
+    # Cm gains (a/d)·CN and Cn gains (a/d)·CY, term by term.
+    arm = (float(aero.moment_ref_x_m) - float(mass.cg_x)) / d
+    return PlantPoint(
+        cy_beta=-c["CNa"], cy_r=0.5 * c["CYr"], cy_delta=c["CY_yaw"],
+        cn_alpha=c["CNa"], cn_q=0.5 * c["CNq"], cn_delta=c["CN_pitch"],
+        cl_p=c["Clp"], cl_delta=c["Cl_roll"],
+        cm_alpha=c["Cma"] + arm * c["CNa"], cm_q=c["Cmq"] + arm * c["CNq"],
+        cm_delta=c["Cm_pitch"] + arm * c["CN_pitch"],
+        cn_yaw_beta=-c["Cma"] - arm * c["CNa"], cn_r=c["Cnr"] + arm * c["CYr"],
+        cn_yaw_delta=c["Cn_yaw"] + arm * c["CY_yaw"],
+        mass=float(mass.mass), ixx=float(mass.ixx), iyy=float(mass.iyy), area=float(aero.reference_area_m2),
+        diameter=d, speed=float(speed), density=float(air.density), omega_a=omega_a,
+    )  # fmt: skip
+
+
+def window_envelope(params: FlightParams, aero: LinearAero, thrust_n, propellant_kg, density, sound, start_s, end_s):
+    """((min, max) speed [m/s], (min, max) altitude above the pad [m]) of the nominal flight off the
+    rail (on it the rocket cannot turn) from ``start_s`` to ``end_s`` after liftoff (first motion),
+    estimated: a point mass up the rail, then turning under gravity (thrust and drag along the
+    velocity), with the thrust [N] and propellant [kg] every ESTIMATE_DT_S from t = 0 to burnout,
+    the zero-lift drag drag_scale·CA0(Mach) at the pad's altitude (no power-on change, no airbrakes)
+    and the ISA's density and speed of sound at ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for
+    Lynx. ConfigError if the flight is not in the air then."""
+    site, motor = float(params.environment.site_altitude_m), params.rocket.motor
+    heights = ESTIMATE_HEIGHTS_M
+    mach_axis = np.asarray(aero.table.axes[aero.table.axis_names.index("mach")])
+    ca0 = float(aero.drag_scale) * np.array([linear_derivatives(aero, m, site)["CA0"] for m in mach_axis])
+    area, dry_kg = float(aero.reference_area_m2), float(params.rocket.dry_mass_kg)
+    sin_e = -float(params.launch.rail_direction_n.z)
+    cos_e = math.sqrt(1.0 - sin_e**2)
+    travel = float(params.launch.rail_length_m - (params.rocket.rear_lug_x_m - motor.nozzle_x_m))
+
+    dt = ESTIMATE_DT_S
+    x = z = vx = vz = 0.0  # along the azimuth and up from the start [m], velocity [m/s]
+    liftoff, speeds, altitudes = None, [], []
+    for k in itertools.count():
+        burning = k < thrust_n.size
+        if liftoff is None and not burning:
+            break  # burnt out on the pad
+        force, mass = (thrust_n[k], dry_kg + propellant_kg[k]) if burning else (0.0, dry_kg)
+        speed = math.hypot(vx, vz)
+        mach = speed / np.interp(z, heights, sound)
+        drag = 0.5 * np.interp(z, heights, density) * speed**2 * area * np.interp(mach, mach_axis, ca0)
+        accel = (force - drag) / mass
+        on_rail = x * cos_e + z * sin_e < travel
+        if on_rail:  # along it, not sliding back from rest
+            along = accel - G0 * sin_e if speed > 0.0 else max(accel - G0 * sin_e, 0.0)
+            ax, az = along * cos_e, along * sin_e
+        else:
+            ax, az = accel * vx / speed, accel * vz / speed - G0
+        if liftoff is None and (ax != 0.0 or az != 0.0):
+            liftoff = k * dt
+        if liftoff is not None:
+            since = k * dt - liftoff
+            if since > end_s or (z < 0.0 and vz < 0.0):
+                break
+            if since >= start_s and not on_rail:
+                speeds.append(speed)
+                altitudes.append(z)
+        x, z = x + (vx + 0.5 * ax * dt) * dt, z + (vz + 0.5 * az * dt) * dt
+        vx, vz = vx + ax * dt, vz + az * dt
+    if not speeds:
+        raise ConfigError(f"gnc.guidance.window_start_s: the nominal flight (a point-mass estimate) is not in the air "
+                          f"from {start_s:g} to {end_s:g} s after liftoff")  # fmt: skip
+    return (float(min(speeds)), float(max(speeds))), (float(min(altitudes)), float(max(altitudes)))
+
+
+def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
+    """ConfigError unless the design grid covers the estimated flight inside the guidance window (an
+    altitude grid of one point designs gains for every altitude)."""
+    control, guidance = campaign.config.gnc.control, campaign.config.gnc.guidance
+    grids = [("speeds_mps", control.speeds_mps, inputs.speeds, "m/s")]
+    if len(control.altitudes_m) > 1:
+        grids.append(("altitudes_m", control.altitudes_m, inputs.altitudes_agl, "m above the pad"))
+    for name, grid, (low, high), unit in grids:
+        if not (grid[0] <= low and high <= grid[-1]):
+            raise ConfigError(
+                f"gnc.control.{name}: the grid spans {grid[0]:g} to {grid[-1]:g} {unit}, the nominal flight "
+                f"{low:.0f} to {high:.0f} {unit} in the guidance window ({guidance.window_start_s:g} to "
+                f"{guidance.window_end_s:g} s after liftoff; a point-mass estimate): extend the grid"
+            )
+
+
+def design_schedule(campaign: Campaign) -> Schedule:
+    """The campaign's gain schedule: speeds [m/s], altitudes [m above mean sea level] (the grid's
+    altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming the field if
+    the grid does not cover the flight or a point has no stabilising design."""
+    inputs = design_inputs(campaign)
+    check_coverage(campaign, inputs)
+    control = campaign.config.gnc.control
+    try:
+        # One BLAS thread: on 11×11 matrices more only contend (measured 2.5 ms a point against 7-25 ms
+        # on 2 busy cores), and the gains (in the set-up's fingerprint) are the same bits on any machine.
+        with threadpool_limits(1):
+            return gain_schedule(
+                lambda speed, altitude: plant_point(inputs.aero, inputs.mass, speed, altitude, inputs.omega_a),
+                control.speeds_mps,
+                campaign.config.site.altitude_m + np.asarray(control.altitudes_m),
+                dt=campaign.config.simulation.control_dt_s,
+                q=np.diag(control.q_weights),
+                r=np.diag(control.r_weights),
+                method=control.discretisation,
+            )
+    except ValueError as err:
+        raise ConfigError(f"gnc.control: {err}") from None
+
+
+STATE = ("v", "w", "p", "q", "r", "u_y", "u_p", "u_r", "e_p", "e_q", "e_r")
+"""The columns of K: the augmented state of GNC.md §5 (``gnc.design``); its rows are (yaw, pitch, roll)."""
+MAIN_GAINS = {"pitch": {"K_w": (1, 1), "K_q": (1, 3), "K_up": (1, 6), "K_eq": (1, 9)},
+              "roll": {"K_p": (2, 2), "K_ur": (2, 7), "K_ep": (2, 8)}}  # fmt: skip
+"""The gains that act in the pitch and roll channels, by (row, column) of K; the yaw row mirrors pitch."""
+
+
+def schedule_summary(campaign: Campaign, inputs: DesignInputs) -> dict:
+    """The campaign's gain schedule and what it was designed from, JSON-able (``rocketmc gnc design``):
+    per grid point speed [m/s], altitude above the pad and above sea level [m], closed-loop spectral
+    radius, relative Riccati residual, K (3, 11) and its ``MAIN_GAINS``."""
+    config, schedule = campaign.config, campaign.gnc_schedule
+    control = config.gnc.control
+    points = [
+        {
+            "speed_mps": float(speed), "altitude_agl_m": control.altitudes_m[j],
+            "altitude_msl_m": float(altitude), "spectral_radius": float(schedule.spectral_radius[i, j]),
+            "riccati_residual": float(schedule.residual[i, j]), "gain": schedule.gains[i, j].tolist(),
+            **{row: {name: float(schedule.gains[i, j][index]) for name, index in gains.items()}
+               for row, gains in MAIN_GAINS.items()},
+        }
+        for i, speed in enumerate(schedule.speeds)
+        for j, altitude in enumerate(schedule.altitudes)
+    ]  # fmt: skip
+    mass = inputs.mass
+    return {
+        "campaign": config.name,
+        "aero_model": config.rocket.aero.model,
+        "dt_s": config.simulation.control_dt_s,
+        "discretisation": control.discretisation,
+        "q_weights": control.q_weights,
+        "r_weights": control.r_weights,
+        "state": STATE,
+        "servo_bandwidth_rad_s": inputs.omega_a,
+        "burnout": {"mass_kg": float(mass.mass), "cg_x_m": float(mass.cg_x), "ixx_kgm2": float(mass.ixx),
+                    "iyy_kgm2": float(mass.iyy)},  # fmt: skip
+        "window_estimate": {"speed_mps": list(inputs.speeds), "altitude_agl_m": list(inputs.altitudes_agl)},
+        "points": points,
+    }

@@ -1,0 +1,166 @@
+"""The closed loop's step at each control period (GNC.md §4-5): navigation → guidance → LQI → canard servos.
+
+At the start of each period t_k the controller reads the navigation solution, computes the body-rate command
+(``guidance.rate_command``), integrates the rate errors, interpolates the LQI gains designed on the host
+(``gnc.design``, carried as a ``Table`` over speed and altitude), forms the three virtual commands u = −K x,
+allocates them to the four fins (``aero.canards.allocate``) and holds them for the servos over the period
+(``dynamics.servo``). Outside the guidance window, before liftoff and once a parachute is triggered the fins
+are commanded to zero.
+
+Pure, single-vehicle, scalar components (no small-array algebra inside the flight loop, see
+docs/sharp-bits.md).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import jax.numpy as jnp
+
+from ..aero.canards import allocate, mix
+from ..dynamics.rigid_body import RigidBodyState
+from ..dynamics.servo import ServoParams, ServoState, hold_command
+from ..math import Vec3
+from ..math.table import Table, interpolate
+from ..pytree import pytree_dataclass, static_field
+from .design import N_INPUT, N_PLANT, N_STATE
+from .guidance import GuidanceParams, Navigation, guidance_active, integrate_errors, rate_command
+
+GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
+"""Outputs of the gain table: K (3, 11) row by row; rows (yaw, pitch, roll), columns GNC.md §5's state
+[v, w, p, q, r, u_y, u_p, u_r, e_p, e_q, e_r]."""
+
+
+@pytree_dataclass
+class GncParams:
+    """servo: the canard servos; guidance: the reference and the rate command; gains: ``Table`` of K over
+    ``speed`` (axial body speed u [m/s]) and, when the design grid has several, ``altitude`` (above mean sea
+    level [m]), outputs ``GAIN_NAMES`` (clamped at the grid's edges); anti_windup: conditional integration
+    (``gnc_step``; static)."""
+
+    servo: ServoParams
+    guidance: GuidanceParams
+    gains: Table
+    anti_windup: bool = static_field(default=True)
+
+
+@pytree_dataclass
+class GncState:
+    """servo: the servos' state; integrators: (e_p, e_q, e_r) [rad]; liftoff_time: the period start at which
+    the rocket was first seen moving [s] (inf before), the guidance clock's zero; command: the last virtual
+    commands (yaw, pitch, roll) [rad]; saturated: they clipped a fin at its limit (bool). Flight totals for the outputs: active_time [s] with the controller
+    active; tracking_sq, ∫χ² dt [rad²·s], and deflection_sq, ∫ mean over the fins of δ² dt [rad²·s], over that
+    time; saturated_time [s] active with a fin saturated; max_deflection, the largest |δ| of any fin at a
+    period start [rad]."""
+
+    servo: ServoState
+    integrators: Vec3
+    liftoff_time: jnp.ndarray
+    command: Vec3
+    saturated: jnp.ndarray
+    active_time: jnp.ndarray
+    tracking_sq: jnp.ndarray
+    deflection_sq: jnp.ndarray
+    saturated_time: jnp.ndarray
+    max_deflection: jnp.ndarray
+
+
+def initial_gnc(params: GncParams, like) -> GncState:
+    """At rest on the rail: servos at their zero, integrators empty, no liftoff yet; ``like`` a scalar of the
+    flight's dtype."""
+    zero = jnp.zeros_like(like)
+    fins = jnp.zeros_like(params.servo.offset_rad)
+    return GncState(
+        ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
+        jnp.zeros_like(zero, dtype=bool),
+        zero, zero, zero, zero, zero,
+    )  # fmt: skip
+
+
+def gains_at(gains: Table, speed, altitude_msl):
+    """K (flat, ``GAIN_NAMES``) at axial speed [m/s] and altitude [m MSL], clamped to the grid."""
+    point = {"speed": speed, "altitude": altitude_msl}
+    return interpolate(gains, tuple(point[name] for name in gains.axis_names))[0]
+
+
+def lqi_command(k, state: tuple) -> tuple:
+    """Virtual commands (yaw, pitch, roll) = −K x [rad] for the 11 state components ``state``; K flat
+    (``GAIN_NAMES``), written out as sums (a vmapped small matrix product is a slow library call on CPU)."""
+    return tuple(-sum(k[i * N_STATE + j] * x for j, x in enumerate(state)) for i in range(N_INPUT))
+
+
+def unwinding_only(k, state: GncState, stepped: Vec3) -> Vec3:
+    """The integrators ``stepped`` (e_p, e_q, e_r) [rad], except, when ``state``'s command saturated a fin,
+    those whose step would move their own virtual command (roll, pitch, yaw: rows 2, 1, 0 of K, flat) further
+    from zero: they keep ``state``'s value."""
+    old, last = state.integrators, state.command
+    kept = []
+    for axis, (row, new, before, command) in enumerate(((2, stepped.x, old.x, last.z), (1, stepped.y, old.y, last.y),
+                                                        (0, stepped.z, old.z, last.x))):  # fmt: skip
+        effect = -k[row * N_STATE + N_PLANT + axis] * (new - before)  # its step's change of the command
+        kept.append(jnp.where(state.saturated & (effect * command > 0.0), before, new))
+    return Vec3(*kept)
+
+
+def gnc_step(params: GncParams, state: GncState, nav: Navigation, t, dt, altitude_msl, canopy) -> GncState:
+    """The GNC at a period start t [s] (simulation clock): liftoff detection, guidance, integrators, LQI,
+    allocation, the command held by the servos, and the totals of the period dt [s] (the GNC period: the
+    controller is never active in the longer descent periods). nav: the navigation solution; altitude_msl:
+    its altitude [m]; canopy: a parachute has been triggered (bool).
+
+    Anti-windup (``params.anti_windup``), conditional integration per axis: while the last command saturated
+    a fin, an integrator steps only if its step moves its own virtual command (roll for e_p, pitch for e_q,
+    yaw for e_r) back toward zero. Holding every integrator instead latches: an integrator whose own value
+    saturates the fins could never unwind."""
+    moving = nav.v_n.dot(nav.v_n) > 0.0
+    liftoff_time = jnp.where(jnp.isinf(state.liftoff_time) & moving, t, state.liftoff_time)
+    since_liftoff = t - liftoff_time  # −inf before liftoff: outside any window
+    active = guidance_active(params.guidance, since_liftoff) & ~canopy
+    rates_cmd, chi = rate_command(params.guidance, nav, since_liftoff)
+    v_b = nav.q_nb.rotate_inverse(nav.v_n)
+    k = gains_at(params.gains, v_b.x, altitude_msl)
+    errors = integrate_errors(state.integrators, rates_cmd, nav.omega_b, dt, active, params.guidance.integrator_gain)
+    if params.anti_windup:
+        errors = unwinding_only(k, state, errors)
+    u_yaw, u_pitch, u_roll, _ = mix(*(state.servo.deflection_rad[i] for i in range(4)))
+    omega = nav.omega_b
+    x = (v_b.y, v_b.z, omega.x, omega.y, omega.z, u_yaw, u_pitch, u_roll, errors.x, errors.y, errors.z)
+    command = Vec3(*(jnp.where(active, u, 0.0) for u in lqi_command(k, x)))  # (yaw, pitch, roll)
+    fins = allocate(*command)
+    saturated = functools.reduce(jnp.logical_or, [jnp.abs(f) > params.servo.limit_rad for f in fins])
+    servo = hold_command(params.servo, state.servo, jnp.stack(fins))
+
+    deflection = state.servo.deflection_rad + params.servo.offset_rad
+    deflections = [deflection[i] for i in range(deflection.shape[0])]
+    active_dt = jnp.where(active, dt, 0.0)
+    return GncState(
+        servo,
+        errors,
+        liftoff_time,
+        command,
+        saturated,
+        state.active_time + active_dt,
+        state.tracking_sq + chi * chi * active_dt,
+        # a reduction, not a chain of additions: XLA fused the chain differently with the batch size (1 ulp)
+        state.deflection_sq + jnp.mean(deflection * deflection) * active_dt,
+        state.saturated_time + jnp.where(saturated, active_dt, 0.0),
+        functools.reduce(jnp.maximum, [jnp.abs(d) for d in deflections], state.max_deflection),
+    )
+
+
+def truth(body: RigidBodyState) -> Navigation:
+    """Perfect navigation (``navigation = "truth"``): the vehicle's true state."""
+    return Navigation(body.r_n, body.v_n, body.q_nb, body.omega_b)
+
+
+def control_summary(state: GncState) -> dict:
+    """The controller's per-flight outputs (``sim.flight.CONTROL_METRICS``); NaN where it never acted."""
+    acted = state.active_time > 0.0
+    per_active = 1.0 / jnp.where(acted, state.active_time, 1.0)
+    return {
+        "control_active_time_s": state.active_time,
+        "tracking_error_rms_rad": jnp.where(acted, jnp.sqrt(state.tracking_sq * per_active), jnp.nan),
+        "canard_deflection_rms_rad": jnp.where(acted, jnp.sqrt(state.deflection_sq * per_active), jnp.nan),
+        "canard_deflection_max_rad": state.max_deflection,
+        "canard_saturated_fraction": jnp.where(acted, state.saturated_time * per_active, jnp.nan),
+    }

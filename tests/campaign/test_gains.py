@@ -1,0 +1,172 @@
+"""The LQI gain schedule a campaign designs at set-up (campaign/gains.py, GNC.md §5): the plant of each
+grid point against a hand-built one and against the nonlinear flight's own derivatives, the stability
+of the default Lynx schedule for each aerodynamic model, the flight estimate behind the grid check,
+and the set-up's fingerprint."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import tomllib
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from rocketmc.aero.canards import allocate
+from rocketmc.campaign import campaign_from_dict
+from rocketmc.campaign.config import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS, preset_rocket
+from rocketmc.campaign.fingerprint import data_digest
+from rocketmc.campaign.gains import design_inputs, plant_point
+from rocketmc.campaign.model import nominal_params
+from rocketmc.gnc.design import THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, lqi_gain, lqi_plant
+from rocketmc.math import Quat, Vec3
+from rocketmc.sim.flight import derivatives, initial_state
+
+from ..conftest import CAMPAIGNS
+
+NOMINAL = tomllib.loads((CAMPAIGNS / "lynx_nominal.toml").read_text())
+SITE_M = NOMINAL["site"]["altitude_m"]  # Roccaraso, 1416 m
+
+
+def lynx(model: str = "linear", gnc: dict | None = None, **rocket) -> dict:
+    """lynx_nominal with ``model`` aerodynamics, a [gnc] section (the defaults unless given), the
+    rocket's fields ``rocket`` overridden."""
+    raw = copy.deepcopy(NOMINAL)
+    raw["rocket"].update(aero={"model": model}, **rocket)
+    return {**raw, "gnc": {} if gnc is None else gnc}
+
+
+@pytest.fixture(scope="module")
+def linear():
+    return campaign_from_dict(lynx("linear"), CAMPAIGNS)
+
+
+@pytest.fixture(scope="module")
+def simplified(linear):
+    """Designed anew by ``with_overrides`` (the CLI's --aero-model): simplify of the build-up tables, ~7 s."""
+    return linear.with_overrides(aero_model="simplified")
+
+
+def test_linear_schedule_is_the_thesis_plant_at_burnout(linear):
+    """A grid point of the linear Lynx against GNC.md §5's plant written by hand: LYNX.md's coefficients
+    (force damping 154 per ω·d/V), the Lynx at burnout (18.362 kg, Ixx 0.06, Iyy 6.436 kg·m², its CG on the
+    moment reference, so no shift), S 0.01767 m², d 0.15 m, ρ of the ISA at the grid altitude above
+    Roccaraso, ω_a = 1/0.0769 s, dt 0.02 s, ZOH, the weights flown."""
+    schedule = linear.gnc_schedule
+    i, j = DEFAULT_SPEEDS_MPS.index(150.0), DEFAULT_ALTITUDES_M.index(1000.0)
+    assert schedule.speeds[i] == 150.0 and schedule.altitudes[j] == SITE_M + 1000.0  # altitudes above sea level
+    point = PlantPoint(
+        cy_beta=-24.0744, cy_r=154.0, cy_delta=3.4045, cn_alpha=24.0744, cn_q=154.0, cn_delta=3.4045,
+        cl_p=-19.0, cl_delta=2.3963, cm_alpha=-37.2959, cm_q=-1813.0, cm_delta=21.8445,
+        cn_yaw_beta=37.2959, cn_r=-1813.0, cn_yaw_delta=21.8445,
+        mass=18.362, ixx=0.06, iyy=6.436, area=0.01767, diameter=0.15,
+        speed=150.0, density=density(SITE_M + 1000.0), omega_a=1.0 / 0.0769,
+    )  # fmt: skip
+    expected = lqi_gain(*discretise(*augment(*lqi_plant(point)), 0.02, "zoh"), THESIS_Q, THESIS_R)
+    # The same arithmetic but for the coefficients' trip through the mixing matrix and the table
+    # (rounding ~1e-16 relative) and the propellant left at burnout (0 to rounding): K (|K| ≲ 2)
+    # agrees to ~1e-14; 1e-12 leaves room and still catches any real difference.
+    np.testing.assert_allclose(schedule.gains[i, j], expected.gain, rtol=0, atol=1e-12)
+    assert schedule.spectral_radius[i, j] == pytest.approx(expected.spectral_radius, abs=1e-12)
+
+
+@pytest.mark.parametrize("model", ["linear", "simplified"])
+def test_default_lynx_schedule_is_stable_and_solved(model, request):
+    schedule = request.getfixturevalue(model).gnc_schedule
+    assert schedule.gains.shape == (len(DEFAULT_SPEEDS_MPS), len(DEFAULT_ALTITUDES_M), 3, 11)
+    np.testing.assert_array_equal(schedule.altitudes, SITE_M + np.asarray(DEFAULT_ALTITUDES_M))
+    assert np.all(schedule.spectral_radius < 1.0), schedule.spectral_radius.max()
+    # scipy's Schur solution satisfies the DARE to rounding (measured < 5e-14 relative).
+    assert np.all(schedule.residual < 1e-9), schedule.residual.max()
+
+
+def test_interpolated_designs_on_its_own_linearisation(simplified):
+    """The interpolated model is designed from ``simplify`` of its tables: the simplified model's gains."""
+    interpolated = campaign_from_dict(lynx("interpolated"), CAMPAIGNS).gnc_schedule
+    assert np.all(interpolated.spectral_radius < 1.0) and np.all(interpolated.residual < 1e-9)
+    # The same derivatives (one simplify, the same bits) through the same design: equal to rounding.
+    np.testing.assert_allclose(interpolated.gains, simplified.gnc_schedule.gains, rtol=0, atol=1e-12)
+
+
+def test_overrides_keep_or_redesign_the_gains(linear, simplified):
+    assert linear.with_overrides(n_realizations=5, seed=1).gnc_schedule is linear.gnc_schedule
+    # The build-up's derivatives are not the thesis's (Cmα, Cm_δ differ by tens of %): other gains.
+    assert np.abs(simplified.gnc_schedule.gains - linear.gnc_schedule.gains).max() > 0.01
+
+
+def test_without_gnc_nothing_is_designed():
+    campaign = campaign_from_dict(NOMINAL, CAMPAIGNS)
+    assert campaign.config.gnc is None and campaign.gnc_schedule is None
+
+
+def shifted_rate_jacobian(raw: dict, speed: float, height: float):
+    """(A rows v, w, p, q, r of the plant the campaign designs from, the same rows by central differences
+    of the flight's own right-hand side ``sim.flight.derivatives``) at axial speed [m/s] and height above
+    the pad [m], coasting (after burnout) in calm air; columns v, w, p, q, r, u_y, u_p, u_r."""
+    campaign = campaign_from_dict({**raw, "environment": {}, "dispersions": {}}, CAMPAIGNS)  # no wind
+    inputs = design_inputs(campaign)
+    point = plant_point(inputs.aero, inputs.mass, speed, SITE_M + height, inputs.omega_a)
+    a_plant = lqi_plant(point)[0][:5]
+
+    params = nominal_params(dataclasses.replace(campaign, config=campaign.config.model_copy(update={"gnc": None})))
+    motor = params.rocket.motor
+    t = motor.ignition_time_s + motor.burn_time_s + 1.0
+    events = dataclasses.replace(initial_state(params).events, rail_exit_time=jnp.zeros(()))  # off the rail
+
+    @jax.jit
+    def body_rates(x):
+        """(v̇, ẇ, ṗ, q̇, ṙ) in body axes at the state x = (v, w, p, q, r, u_y, u_p, u_r): the body x axis
+        north and level (body = NED), so v̇_b = a_n − ω × v_b; gravity is a constant and drops out."""
+        v_b, omega = Vec3(speed, x[0], x[1]), Vec3(x[2], x[3], x[4])
+        body = initial_state(params).body._replace(
+            r_n=Vec3(0.0, 0.0, -height), v_n=v_b, q_nb=Quat(1.0, 0.0, 0.0, 0.0), omega_b=omega
+        )
+        d_body, _ = derivatives(t, body, params, jnp.stack(allocate(x[5], x[6], x[7])), Vec3(0.0, 0.0, 0.0), events)
+        accel = d_body.v_n - omega.cross(v_b)
+        return jnp.stack([accel.y, accel.z, d_body.omega_b.x, d_body.omega_b.y, d_body.omega_b.z])
+
+    h = 1e-4
+    steps = jnp.asarray(np.vstack([h * np.eye(8), -h * np.eye(8)]))
+    values = np.asarray(jax.vmap(body_rates)(steps))
+    return a_plant, (values[:8] - values[8:]).T / (2 * h)
+
+
+def test_moments_about_a_shifted_cg_against_the_flight():
+    """The dry CG 7 cm aft of the moment reference (Lynx's is on it): a = x_ref − x_cg = +0.07 m, and the
+    plant's pitch and yaw moments gain (a/d)·CN and (a/d)·CY terms. Its A (rates and lateral forces) is
+    the Jacobian of the flight's own right-hand side there: signs, the halved force damping and the
+    per-virtual-command derivatives included."""
+    rocket = preset_rocket("lynx")
+    raw = lynx("linear", dry_cg_m=rocket["reference_point_m"] + 0.07)
+    a_plant, a_flight = shifted_rate_jacobian(raw, speed=120.0, height=800.0)
+    cm_alpha = a_plant[3, 1]  # q̇ per w: Cm_α·k_s·u, about the CG
+    unshifted = shifted_rate_jacobian(lynx("linear"), speed=120.0, height=800.0)[0]
+    # The shift is no rounding: (a/d)·CNα = 0.47·24.07 = 11.2 against Cmα = −37.3 moves q̇/w by 30 %
+    # (the wrong sign would move it by as much the other way).
+    assert 0.2 < (cm_alpha - unshifted[3, 1]) / -unshifted[3, 1] < 0.4
+    # Central differences, step 1e-4 in m/s, rad/s and rad: truncation ~h²·(third derivatives of atan2,
+    # asin, the arm's cross product) ~1e-8 relative; rounding ~ε·|f|/h ~1e-12·|f|/1e-4. Entries reach
+    # ~1e2 (|u| = 120 in the kinematic terms), and the smallest non-zero ones ~1e-1: 1e-6 relative
+    # plus 1e-7 absolute is far above both and far below any convention slip (a factor 2 or a sign).
+    np.testing.assert_allclose(a_plant, a_flight, rtol=1e-6, atol=1e-7)
+
+
+def test_window_estimate_of_lynx(linear):
+    """The point-mass estimate the grid check uses, on Lynx (1-10 s after liftoff): the 6-DOF flight
+    (calm, linear model) measured 62.0-183.3 m/s and 31-1224 m above the pad there. The estimate has
+    no rotation and starts the CG at the pad (it starts ~1 m up the rail): within 1 % and 5 m."""
+    inputs = design_inputs(linear)
+    np.testing.assert_allclose(inputs.speeds, (62.0, 183.3), rtol=0.01)
+    np.testing.assert_allclose(inputs.altitudes_agl, (31.2, 1223.6), atol=5.0)
+
+
+def test_gains_are_in_the_fingerprint(linear):
+    """A resumed run refuses chunks of other gains: the digest of the set-up's data changes with them."""
+    weights = lynx("linear", gnc={"control": {"q_weights": [0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 20.0]}})
+    other = campaign_from_dict(weights, CAMPAIGNS)
+    assert not np.array_equal(other.gnc_schedule.gains, linear.gnc_schedule.gains)
+    assert data_digest(other) != data_digest(linear)
+    assert data_digest(campaign_from_dict(lynx("linear"), CAMPAIGNS)) == data_digest(linear)  # reproducible
+    assert data_digest(dataclasses.replace(linear, gnc_schedule=None)) != data_digest(linear)
