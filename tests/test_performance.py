@@ -2,9 +2,9 @@
 
 Marked ``performance``: ``make test`` runs them alone after the parallel suite, since another test
 process on the same cores would bias the timings. ``rocketmc.bench.ratios`` compiles the three
-flight functions first, then times them in interleaved rounds (best of each) in process CPU time,
+flight functions first, then times them in ``ROUNDS`` interleaved rounds (best of each) in process CPU time,
 so that machine noise hits them alike and other programs on the cores do not stretch them (measured
-with two busy loops on the 2 cores: 22.8x and 1.23x, idle 22.3x and 1.36x). About a minute on the 2-core machine (three compilations, then 1024-flight batches), then
+with two busy loops on the 2 cores: 22.8x and 1.23x, idle 22.3x and 1.36x). About two minutes on the 2-core machine (three compilations, then 1024-flight batches), then
 about a minute for ``closed_loop_ratio`` (two more); ``-s`` prints the ratios.
 """
 
@@ -16,10 +16,15 @@ from rocketmc.bench import closed_loop_ratio, ratios
 
 pytestmark = pytest.mark.performance
 
+ROUNDS = 10
+"""Interleaved rounds, the best of each function's kept. One 1024-flight batch's CPU time varies by ±15 % from
+round to round on the idle 2-core VM (interpolated / simplified 1.03-1.60 in single rounds, 1.35 best of 8):
+with 5 rounds the best-of ratio still came out 1.42-1.71 for the same compiled programs."""
+
 
 @pytest.fixture(scope="module")
 def measured(lynx_campaign):
-    r = ratios(lynx_campaign, repeats=5)  # best of 5 interleaved rounds: this VM's noise comes in bursts of seconds
+    r = ratios(lynx_campaign, repeats=ROUNDS)
     print(f"\nbatch of {r['batch']} against a loop of {r['loop_flights']}: {r['loop_over_batch']:.1f}x faster per "
           f"flight; interpolated / simplified: {r['interpolated_over_simplified']:.2f}x")  # fmt: skip
     return r
@@ -42,7 +47,7 @@ def test_interpolated_costs_at_most_1_5x_the_simplified(measured):
 
 @pytest.fixture(scope="module")
 def closed_loop(lynx_campaign):
-    r = closed_loop_ratio(lynx_campaign, repeats=5)
+    r = closed_loop_ratio(lynx_campaign, repeats=ROUNDS)
     print(f"\nclosed loop {1 / r['closed_over_open_loop']:.2f}x the open loop's flights/s")
     return r
 
