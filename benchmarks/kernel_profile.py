@@ -66,8 +66,8 @@ def main() -> None:
 
     def steps(params, state):
         def one(p, s):
-            neutral, calm = jnp.zeros(p.rocket.aero.n_canards), jnp.zeros(10, jnp.float32)
-            step = lambda s, _: (flight.control_step(p, settings, flight.rail_start_n(p), s, lambda t: neutral, calm), None)  # noqa: E731
+            calm = jnp.zeros(10, jnp.float32)
+            step = lambda s, _: (flight.step(p, settings, flight.rail_start_n(p), s, calm), None)  # noqa: E731
             return jax.lax.scan(step, s, None, args.steps)[0]
 
         return jax.vmap(one)(params, state)

@@ -242,13 +242,13 @@ def _aero_derivatives(args) -> int:
 
 def _gnc_design(args) -> int:
     from .analysis.plots import plot_gains
-    from .campaign.gains import design_inputs, schedule_summary
+    from .campaign.gains import schedule_summary
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     campaign = _campaign(args.campaign, aero_model=args.aero_model)
     if campaign.gnc_schedule is None:
         raise RocketmcError(f"{args.campaign}: no [gnc] section, so no gains to design")
-    summary = schedule_summary(campaign, design_inputs(campaign))
+    summary = schedule_summary(campaign)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:

@@ -126,8 +126,7 @@ def plot_gains(summary: dict, path: str | Path | None = None) -> Figure:
     closed-loop spectral radius against speed [m/s], one line per design altitude above the pad; saved
     to ``path`` if given."""
     points = summary["points"]
-    panels = [(row, name) for row, gains in (("pitch", ("K_w", "K_q", "K_up", "K_eq")), ("roll", ("K_p", "K_ur", "K_ep")))
-              for name in gains] + [(None, "spectral_radius")]  # fmt: skip
+    panels = [(row, name) for row in ("pitch", "roll") for name in points[0][row]] + [(None, "spectral_radius")]
     fig = Figure(figsize=(13.0, 6.5), layout="constrained")
     axes = fig.subplots(2, 4, sharex=True).ravel()
     for altitude in sorted({p["altitude_agl_m"] for p in points}):

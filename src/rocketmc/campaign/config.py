@@ -12,7 +12,7 @@ import hashlib
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
@@ -28,6 +28,9 @@ from ..errors import RocketmcError
 from ..gnc.design import Schedule
 from ..env.wind import POWER_LAW_FLOOR_M, read_wind_profile
 from ..math.table import Table
+
+if TYPE_CHECKING:
+    from .gains import DesignInputs
 
 DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment", "gnc")
 FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "rocket.geometry.", "rocket.aero.")
@@ -569,7 +572,8 @@ class Campaign:
     folder its relative file names are resolved from, the measured wind profile (altitude above
     ground [m], speed [m/s], from-direction [rad]) when the wind model is ``profile``, and with a
     [gnc] section the LQI gain schedule (``campaign/gains.py``): gains over speeds [m/s] × altitudes
-    [m above mean sea level: the grid's altitudes_m plus site.altitude_m]."""
+    [m above mean sea level: the grid's altitudes_m plus site.altitude_m], and what it was designed from
+    (``gains.DesignInputs``: the linearised aerodynamics, the rocket at burnout, the window estimate)."""
 
     config: CampaignConfig
     text: str
@@ -581,6 +585,7 @@ class Campaign:
     wind_profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     files: dict[str, str] = dataclasses.field(default_factory=dict)
     gnc_schedule: Schedule | None = None
+    gnc_inputs: DesignInputs | None = None
 
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
@@ -603,17 +608,19 @@ class Campaign:
             campaign = dataclasses.replace(campaign, aero=_aero_model(config.rocket, self.base_dir),
                                            files=_file_digests(config, self.base_dir))  # fmt: skip
         if new_aero or config.gnc != self.config.gnc:
-            campaign = _with_gains(dataclasses.replace(campaign, gnc_schedule=None))
+            campaign = _with_gains(campaign)
         return campaign
 
 
 def _with_gains(campaign: Campaign) -> Campaign:
-    """``campaign`` with its LQI gain schedule designed (``campaign/gains.py``) if it has a [gnc] section."""
+    """``campaign`` with its LQI gain schedule and what it was designed from (``campaign/gains.py``), both
+    None without a [gnc] section."""
     if campaign.config.gnc is None:
-        return campaign
-    from .gains import design_schedule  # gains imports campaign.model, which imports this module
+        return dataclasses.replace(campaign, gnc_schedule=None, gnc_inputs=None)
+    from .gains import design_inputs, design_schedule  # gains imports campaign.model, which imports this module
 
-    return dataclasses.replace(campaign, gnc_schedule=design_schedule(campaign))
+    inputs = design_inputs(campaign)
+    return dataclasses.replace(campaign, gnc_schedule=design_schedule(campaign, inputs), gnc_inputs=inputs)
 
 
 SHOWN_INPUT_LENGTH = 60

@@ -172,11 +172,10 @@ def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
             )
 
 
-def design_schedule(campaign: Campaign) -> Schedule:
-    """The campaign's gain schedule: speeds [m/s], altitudes [m above mean sea level] (the grid's
-    altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming the field if
-    the grid does not cover the flight or a point has no stabilising design."""
-    inputs = design_inputs(campaign)
+def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
+    """The campaign's gain schedule from its ``design_inputs``: speeds [m/s], altitudes [m above mean sea
+    level] (the grid's altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming
+    the field if the grid does not cover the flight or a point has no stabilising design."""
     check_coverage(campaign, inputs)
     control = campaign.config.gnc.control
     try:
@@ -203,11 +202,11 @@ MAIN_GAINS = {"pitch": {"K_w": (1, 1), "K_q": (1, 3), "K_up": (1, 6), "K_eq": (1
 """The gains that act in the pitch and roll channels, by (row, column) of K; the yaw row mirrors pitch."""
 
 
-def schedule_summary(campaign: Campaign, inputs: DesignInputs) -> dict:
+def schedule_summary(campaign: Campaign) -> dict:
     """The campaign's gain schedule and what it was designed from, JSON-able (``rocketmc gnc design``):
     per grid point speed [m/s], altitude above the pad and above sea level [m], closed-loop spectral
     radius, relative Riccati residual, K (3, 11) and its ``MAIN_GAINS``."""
-    config, schedule = campaign.config, campaign.gnc_schedule
+    config, schedule, inputs = campaign.config, campaign.gnc_schedule, campaign.gnc_inputs
     control = config.gnc.control
     points = [
         {

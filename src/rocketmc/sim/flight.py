@@ -313,16 +313,15 @@ def control_period(p: FlightParams, settings: SimSettings, state: FlightState):
 
 
 def control_step(
-    p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, deflections, noise=None
+    p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None
 ) -> FlightState:
-    """One control period (``control_period``) with the turbulent gust held: RK4 substeps of the rigid
-    body with events, then the turbulence filters advanced over the period with ``noise``, the
-    period's row of ``block_noise`` (None without turbulence); ``tick`` + 1.
+    """One control period of ``period`` [s] (``control_period``) with the turbulent gust held: RK4 substeps
+    of the rigid body with events, then the turbulence filters advanced over the period with ``noise``,
+    the period's row of ``block_noise`` (None without turbulence); ``tick`` + 1.
 
     deflections: the canard deflections δ1..δn [rad] as a function of the time t [s] inside the
     period (held, or the servos' response evaluated at each RK4 stage).
     """
-    period = control_period(p, settings, state)
     h = period / settings.substeps
     turbulence = p.environment.turbulence
     altitude = -state.body.r_n.z
@@ -358,18 +357,20 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     ``control_step``. start_n: ``rail_start_n(p)``; canard_command: open-loop deflections, a function
     of time [s] returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when
     ``p.gnc`` is set: guidance and control at the period start, the servos' response inside it)."""
+    period = control_period(p, settings, state)
     if p.gnc is None:
         held = jnp.zeros(p.rocket.aero.n_canards) if canard_command is None else canard_command(state.t)
         held = jnp.asarray(held, dtype=float)
-        return control_step(p, settings, start_n, state, lambda t: held, noise)
+        return control_step(p, settings, start_n, state, period, lambda t: held, noise)
     if canard_command is not None:
         raise ValueError("canard_command flies open loop: it needs a flight without a controller (p.gnc None)")
     servo_params, t0 = p.gnc.servo, state.t
     canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in state.events.chute_trigger_times], False)
     altitude_msl = p.environment.site_altitude_m - state.body.r_n.z
     gnc = gnc_step(p.gnc, state.gnc, truth(state.body), t0, settings.control_dt_s, altitude_msl, canopy)
-    servo = end_of_period(servo_params, gnc.servo, control_period(p, settings, state))
-    state = control_step(p, settings, start_n, state, lambda t: deflection_at(servo_params, gnc.servo, t - t0), noise)
+    servo = end_of_period(servo_params, gnc.servo, period)
+    state = control_step(p, settings, start_n, state, period, lambda t: deflection_at(servo_params, gnc.servo, t - t0),
+                         noise)  # fmt: skip
     return dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
 
 
