@@ -1,6 +1,6 @@
 """The full benchmark set (``rocketmc bench`` with every size): both aerodynamic models and both
 precisions at N = 1 000, 10 000 and 100 000, float32 against float64 on the same realizations and
-issue 6's ratios timed together; the readable table on stdout, the JSON in OUT.
+the ratios timed together (the batch against a loop on every core, the model costs on one); the readable table on stdout, the JSON in OUT.
 
     python benchmarks/throughput.py OUT.json [--campaign FILE] [--n 1000 10000 100000] [--chunk-size C]
 

@@ -4,9 +4,10 @@
   aerodynamic model, precision and N;
 - float32 against float64: their speeds, and the distances between the impact points of the same
   realizations flown in both;
-- issue 6's ratios, timed together in one process: the vmapped batch against single flights in a
-  loop, the interpolated aerodynamics against the simplified; in another, issue 16's: the closed loop
-  (perfect navigation) against the same flights with the controller off.
+- ratios timed together in one process: the vmapped batch against single flights in a loop (every
+  core; issue 6); in another, on one core and one thread, the costs per flight: the interpolated
+  aerodynamics against the simplified (issue 6), the closed loop (perfect navigation) against the
+  same flights with the controller off (issue 16).
 
 Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
 resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
@@ -93,33 +94,34 @@ def _batch() -> int:
 
 
 def ratios(campaign, repeats: int = 3) -> dict:
-    """Issue 6's ratios on ``campaign``: seconds per flight [s] of ``LOOP_FLIGHTS`` simplified single
-    flights in a loop and of a vmapped batch (``_batch``) with each model; ``loop_over_batch``
-    (simplified) and ``interpolated_over_simplified`` (batches), timed together (``_timed_together``)."""
-    simplified, interpolated = (campaign.with_overrides(aero_model=m) for m in MODELS)
+    """Issue 6's batch ratio on ``campaign``, simplified model, on every core: seconds per flight [s] of
+    ``LOOP_FLIGHTS`` single flights in a loop and of a vmapped batch (``_batch``), timed together
+    (``_timed_together``); ``loop_over_batch``."""
+    simplified = campaign.with_overrides(aero_model="simplified")
     batch = _batch()
     s = _timed_together(campaign, {
         "loop": (single_flights, (simplified,), LOOP_FLIGHTS),
-        "simplified": (compile_chunk, (simplified, batch), batch),
-        "interpolated": (compile_chunk, (interpolated, batch), batch),
+        "batch": (compile_chunk, (simplified, batch), batch),
     }, repeats)  # fmt: skip
-    return {"loop_flights": LOOP_FLIGHTS, "batch": batch, "s_per_flight": s,
-            "loop_over_batch": s["loop"] / s["simplified"],
-            "interpolated_over_simplified": s["interpolated"] / s["simplified"]}  # fmt: skip
+    return {"loop_flights": LOOP_FLIGHTS, "batch": batch, "s_per_flight": s, "loop_over_batch": s["loop"] / s["batch"]}
 
 
-def closed_loop_ratio(campaign, repeats: int = 3) -> dict:
-    """Issue 16's ratio on ``campaign``, simplified model: seconds per flight [s] of vmapped batches
-    (``_batch``) with the controller off and on (the campaign's [gnc], or its defaults; perfect
-    navigation), timed together in their own process (a third compiled function beside the other ratios'
-    moved their timings by ~10 %); ``closed_over_open_loop``, the closed loop's cost per flight."""
+def costs(campaign, repeats: int = 3) -> dict:
+    """The cost ratios of issues 6 and 16 on ``campaign``, per flight of vmapped batches (``_batch``), timed
+    together: the interpolated aerodynamics against the simplified (controller off), and the closed loop
+    (the campaign's [gnc] or its defaults, perfect navigation) against the same flights with the controller
+    off (simplified). Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
+    work a flight takes, and on one thread the best rounds of a function agree within ~5 % where the
+    two-core rounds, whose threads wait on each other, spread ~10 % (measured on the 2-core VM)."""
     open_loop = campaign.with_overrides(aero_model="simplified", controller=False)
     batch = _batch()
     s = _timed_together(campaign, {
-        "open_loop": (compile_chunk, (open_loop, batch), batch),
+        "simplified": (compile_chunk, (open_loop, batch), batch),
+        "interpolated": (compile_chunk, (open_loop.with_overrides(aero_model="interpolated"), batch), batch),
         "closed_loop": (compile_chunk, (open_loop.with_overrides(controller=True), batch), batch),
     }, repeats)  # fmt: skip
-    return {"batch": batch, "s_per_flight": s, "closed_over_open_loop": s["closed_loop"] / s["open_loop"]}
+    return {"batch": batch, "s_per_flight": s, "interpolated_over_simplified": s["interpolated"] / s["simplified"],
+            "closed_over_open_loop": s["closed_loop"] / s["simplified"]}  # fmt: skip
 
 
 @contextlib.contextmanager
@@ -163,12 +165,13 @@ def throughput(campaign, chunk_size: int | None = None, impacts: str | None = No
 
 def _measure(spec: dict) -> dict:
     """One measurement in this process (``spec`` from ``_subprocess``), with this process's
-    precision and peak resident memory [MB]."""
+    precision and peak resident memory [MB]. ``costs`` pins the process to one core first (before XLA starts
+    its threads, which inherit it)."""
+    if spec["kind"] == "costs" and hasattr(os, "sched_setaffinity"):
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
     campaign = load_campaign(spec["campaign"])
-    if spec["kind"] == "ratios":
-        result = ratios(campaign)
-    elif spec["kind"] == "closed_loop":
-        result = closed_loop_ratio(campaign)
+    if spec["kind"] in TIMED_TOGETHER:
+        result = TIMED_TOGETHER[spec["kind"]](campaign, spec["repeats"])
     else:
         campaign = campaign.with_overrides(n_realizations=spec["n"], aero_model=spec["model"])
         with float32_draws() if spec["float32_draws"] else contextlib.nullcontext():
@@ -179,19 +182,31 @@ def _measure(spec: dict) -> dict:
 
 # --- orchestration (in the calling process) ------------------------------------------------------
 
+TIMED_TOGETHER = {"ratios": ratios, "costs": costs}
+"""The measurements that time several flight functions together in one process, by kind."""
+
 
 class BenchError(RuntimeError):
     """A measuring process failed; the message is one line."""
 
 
+ONE_THREAD_XLA_FLAGS = (
+    "--xla_force_host_platform_device_count=1 --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+)
+"""XLA on one device and one thread: the cost measurements' process (``costs``, which pins itself to one core)."""
+
+
 def _subprocess(precision: str, **spec) -> dict:
-    """``_measure(spec)`` in a fresh process with ``ROCKETMC_PRECISION=precision``."""
+    """``_measure(spec)`` in a fresh process with ``ROCKETMC_PRECISION=precision``; ``costs`` with
+    ``ONE_THREAD_XLA_FLAGS``."""
     env = {**os.environ, "ROCKETMC_PRECISION": precision}
+    if spec["kind"] == "costs":
+        env["XLA_FLAGS"] = ONE_THREAD_XLA_FLAGS
     command = [sys.executable, "-m", "rocketmc.bench", json.dumps(spec)]
     done = subprocess.run(command, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
-        what = spec["kind"] if spec["kind"] in ("ratios", "closed_loop") else f"{spec['model']}, N = {spec['n']}"
+        what = spec["kind"] if spec["kind"] in TIMED_TOGETHER else f"{spec['model']}, N = {spec['n']}"
         raise BenchError(f"the measurement ({what}, {precision}) failed: {last}")
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -269,12 +284,18 @@ def run_benchmarks(
             report["float32_vs_float64"] = {"n": compared[0], "model": compared[1], **c}
             log(f"float32 against float64 on the same realizations: impact points "
                 f"{c['impact_difference_m']['median']:.2f} m apart (median)")  # fmt: skip
-    r = report["ratios"] = _subprocess(precisions[0], kind="ratios", campaign=path)
-    log(f"ratios ({precisions[0]}): batch {r['loop_over_batch']:.1f}x faster per flight than a loop, "
-        f"interpolated {r['interpolated_over_simplified']:.2f}x the simplified")  # fmt: skip
-    c = report["closed_loop"] = _subprocess(precisions[0], kind="closed_loop", campaign=path)
-    log(f"closed loop ({precisions[0]}): {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s")
+    r = report["ratios"] = measure("ratios", path, precisions[0])
+    log(f"batch ({precisions[0]}): {r['loop_over_batch']:.1f}x faster per flight than a loop")
+    c = report["costs"] = measure("costs", path, precisions[0])
+    log(f"costs ({precisions[0]}, one core): interpolated {c['interpolated_over_simplified']:.2f}x the simplified, "
+        f"closed loop {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s")  # fmt: skip
     return report
+
+
+def measure(kind: str, campaign: str | Path = DEFAULT_CAMPAIGN, precision: str = "float64", repeats: int = 3) -> dict:
+    """``ratios`` or ``costs`` (``kind``) of the campaign file in their own process, best of ``repeats``
+    interleaved rounds each."""
+    return _subprocess(precision, kind=kind, campaign=str(Path(campaign).resolve()), repeats=repeats)
 
 
 def format_report(report: dict) -> str:
@@ -312,15 +333,16 @@ def format_report(report: dict) -> str:
     s = r["s_per_flight"]
     lines.append(
         f"  timed together ({r['precision']}): a vmapped batch of {r['batch']} flies {r['loop_over_batch']:.1f}x "
-        f"faster per flight than {r['loop_flights']} single flights in a loop ({1e3 * s['simplified']:.2f} against "
-        f"{1e3 * s['loop']:.1f} ms, simplified); interpolated / simplified {r['interpolated_over_simplified']:.2f}x"
+        f"faster per flight than {r['loop_flights']} single flights in a loop ({1e3 * s['batch']:.2f} against "
+        f"{1e3 * s['loop']:.1f} ms, simplified)"
     )
-    c = report["closed_loop"]
+    c = report["costs"]
     s = c["s_per_flight"]
     lines.append(
-        f"  closed loop (perfect navigation, simplified, timed together): {1 / c['closed_over_open_loop']:.2f}x the "
-        f"flights/s of the same flights with the controller off ({1e3 * s['closed_loop']:.2f} against "
-        f"{1e3 * s['open_loop']:.2f} ms per flight)"
+        f"  costs per flight on one core, timed together (batches of {c['batch']}): interpolated / simplified "
+        f"{c['interpolated_over_simplified']:.2f}x ({1e3 * s['interpolated']:.2f} against {1e3 * s['simplified']:.2f} "
+        f"ms); closed loop (perfect navigation, simplified) {1 / c['closed_over_open_loop']:.2f}x the flights/s "
+        f"of the same flights with the controller off ({1e3 * s['closed_loop']:.2f} ms)"
     )
     return "\n".join(lines)
 

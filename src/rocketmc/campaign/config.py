@@ -782,7 +782,7 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
     motor = config.rocket.motor
     if motor.isp_s is not None:
         curve_isp = cumulative_impulse(time_s, thrust_n)[-1] / (G0 * motor.propellant_mass_kg)
-        if abs(curve_isp / motor.isp_s - 1.0) > ISP_TOLERANCE:
+        if abs(curve_isp - motor.isp_s) > ISP_TOLERANCE * motor.isp_s:
             raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
                               f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
 
