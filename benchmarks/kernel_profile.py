@@ -66,8 +66,8 @@ def main() -> None:
 
     def steps(params, state):
         def one(p, s):
-            calm = jnp.zeros(10, jnp.float32)
-            step = lambda s, _: (flight.step(p, settings, flight.rail_start_n(p), s, calm), None)  # noqa: E731
+            noise = jax.tree_util.tree_map(lambda x: x[0], flight.block_noise(p, jnp.uint32(0), 1))
+            step = lambda s, _: (flight.step(p, settings, flight.rail_start_n(p), s, noise), None)  # noqa: E731
             return jax.lax.scan(step, s, None, args.steps)[0]
 
         return jax.vmap(one)(params, state)

@@ -164,11 +164,12 @@ def test_help_matches_the_readme(capsys):
     added without the README saying so fails) and the same choices where the README lists them."""
     documented = _readme_commands()
     assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
-                               ("validate",), ("bench",)}  # fmt: skip
+                               ("sensors", "simulate"), ("validate",), ("bench",)}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "gnc")).group(1).split(",") == ["design"]
+    assert re.search(r"\{([a-z,]+)\}", _help(capsys, "sensors")).group(1).split(",") == ["simulate"]
     for words, (options, choices) in documented.items():
         text = _help(capsys, *words)
         assert text.startswith(f"usage: rocketmc {' '.join(words)} "), text

@@ -1,4 +1,5 @@
-"""The performance ratios (issues 6 and 16), measured together in one run on one machine, never absolute times.
+"""The performance ratios (issues 6 and 16), measured together in one run on one machine, never absolute times;
+issue 17's sensors cost is printed (``-s``), its bound of 1.3x not met yet (docs/performance.md).
 
 Marked ``performance``: ``make test`` runs them alone after the parallel suite, since another test
 process on the same cores would bias the timings. Each measurement (``rocketmc.bench.measure``) runs in
@@ -39,7 +40,8 @@ def measured():
 def cost():
     r = measure("costs", CAMPAIGN, repeats=ROUNDS)
     print(f"\none core: interpolated / simplified {r['interpolated_over_simplified']:.2f}x; closed loop "
-          f"{1 / r['closed_over_open_loop']:.2f}x the open loop's flights/s")  # fmt: skip
+          f"{1 / r['closed_over_open_loop']:.2f}x the open loop's flights/s; sensors "
+          f"{r['sensors_over_closed_loop']:.2f}x the closed loop's cost")  # fmt: skip
     return r
 
 
@@ -64,3 +66,4 @@ def test_closed_loop_flies_at_least_0_7x_the_open_loops_flights_per_second(cost)
     # host callback, a Python branch that recompiles, or small-matrix algebra under vmap would break it.
     flights_per_s = 1.0 / cost["closed_over_open_loop"]
     assert flights_per_s >= 0.7, f"the closed loop flies {flights_per_s:.2f}x the open loop's flights per second"
+

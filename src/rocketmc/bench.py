@@ -7,7 +7,7 @@
 - ratios timed together in one process: the vmapped batch against single flights in a loop (every
   core; issue 6); in another, on one core and one thread, the costs per flight: the interpolated
   aerodynamics against the simplified (issue 6), the closed loop (perfect navigation) against the
-  same flights with the controller off (issue 16).
+  same flights with the controller off (issue 16), the closed loop on raw sensors against it (issue 17).
 
 Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
 resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
@@ -107,21 +107,25 @@ def ratios(campaign, repeats: int = 3) -> dict:
 
 
 def costs(campaign, repeats: int = 3) -> dict:
-    """The cost ratios of issues 6 and 16 on ``campaign``, per flight of vmapped batches (``_batch``), timed
-    together: the interpolated aerodynamics against the simplified (controller off), and the closed loop
-    (the campaign's [gnc] or its defaults, perfect navigation) against the same flights with the controller
-    off (simplified). Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
+    """The cost ratios of issues 6, 16 and 17 on ``campaign``, per flight of vmapped batches (``_batch``), timed
+    together: the interpolated aerodynamics against the simplified (controller off), the closed loop (the
+    campaign's [gnc] or its defaults, perfect navigation) against the same flights with the controller off
+    (simplified), and the closed loop on raw sensors (the campaign's [avionics] or the thesis's parts)
+    against the closed loop on perfect navigation. Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
     work a flight takes, and on one thread the best rounds of a function agree within ~5 % where the
     two-core rounds, whose threads wait on each other, spread ~10 % (measured on the 2-core VM)."""
-    open_loop = campaign.with_overrides(aero_model="simplified", controller=False)
+    open_loop = campaign.with_overrides(aero_model="simplified", controller=False, sensors=False)
+    closed_loop = open_loop.with_overrides(controller=True)
     batch = _batch()
     s = _timed_together(campaign, {
         "simplified": (compile_chunk, (open_loop, batch), batch),
         "interpolated": (compile_chunk, (open_loop.with_overrides(aero_model="interpolated"), batch), batch),
-        "closed_loop": (compile_chunk, (open_loop.with_overrides(controller=True), batch), batch),
+        "closed_loop": (compile_chunk, (closed_loop, batch), batch),
+        "sensors": (compile_chunk, (closed_loop.with_overrides(sensors=True), batch), batch),
     }, repeats)  # fmt: skip
     return {"batch": batch, "s_per_flight": s, "interpolated_over_simplified": s["interpolated"] / s["simplified"],
-            "closed_over_open_loop": s["closed_loop"] / s["simplified"]}  # fmt: skip
+            "closed_over_open_loop": s["closed_loop"] / s["simplified"],
+            "sensors_over_closed_loop": s["sensors"] / s["closed_loop"]}  # fmt: skip
 
 
 @contextlib.contextmanager
@@ -165,10 +169,7 @@ def throughput(campaign, chunk_size: int | None = None, impacts: str | None = No
 
 def _measure(spec: dict) -> dict:
     """One measurement in this process (``spec`` from ``_subprocess``), with this process's
-    precision and peak resident memory [MB]. ``costs`` pins the process to one core first (before XLA starts
-    its threads, which inherit it)."""
-    if spec["kind"] == "costs" and hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    precision and peak resident memory [MB]."""
     campaign = load_campaign(spec["campaign"])
     if spec["kind"] in TIMED_TOGETHER:
         result = TIMED_TOGETHER[spec["kind"]](campaign, spec["repeats"])
@@ -193,17 +194,34 @@ class BenchError(RuntimeError):
 ONE_THREAD_XLA_FLAGS = (
     "--xla_force_host_platform_device_count=1 --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
 )
-"""XLA on one device and one thread: the cost measurements' process (``costs``, which pins itself to one core)."""
+"""XLA on one device and one thread: the cost measurements' process (``costs``, pinned to one core)."""
+
+
+@contextlib.contextmanager
+def _one_core():
+    """This thread pinned to one of its cores while inside (where the OS can pin): a process it starts inherits
+    that affinity, every thread of it included."""
+    if not hasattr(os, "sched_setaffinity"):
+        yield
+        return
+    cores = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {min(cores)})
+    try:
+        yield
+    finally:
+        os.sched_setaffinity(0, cores)
 
 
 def _subprocess(precision: str, **spec) -> dict:
-    """``_measure(spec)`` in a fresh process with ``ROCKETMC_PRECISION=precision``; ``costs`` with
-    ``ONE_THREAD_XLA_FLAGS``."""
+    """``_measure(spec)`` in a fresh process with ``ROCKETMC_PRECISION=precision``; ``costs`` on one core
+    with ``ONE_THREAD_XLA_FLAGS``."""
     env = {**os.environ, "ROCKETMC_PRECISION": precision}
-    if spec["kind"] == "costs":
+    one_core = spec["kind"] == "costs"
+    if one_core:
         env["XLA_FLAGS"] = ONE_THREAD_XLA_FLAGS
     command = [sys.executable, "-m", "rocketmc.bench", json.dumps(spec)]
-    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    with _one_core() if one_core else contextlib.nullcontext():
+        done = subprocess.run(command, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
         what = spec["kind"] if spec["kind"] in TIMED_TOGETHER else f"{spec['model']}, N = {spec['n']}"
@@ -288,7 +306,8 @@ def run_benchmarks(
     log(f"batch ({precisions[0]}): {r['loop_over_batch']:.1f}x faster per flight than a loop")
     c = report["costs"] = measure("costs", path, precisions[0])
     log(f"costs ({precisions[0]}, one core): interpolated {c['interpolated_over_simplified']:.2f}x the simplified, "
-        f"closed loop {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s")  # fmt: skip
+        f"closed loop {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s, sensors "
+        f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost")  # fmt: skip
     return report
 
 
@@ -342,7 +361,8 @@ def format_report(report: dict) -> str:
         f"  costs per flight on one core, timed together (batches of {c['batch']}): interpolated / simplified "
         f"{c['interpolated_over_simplified']:.2f}x ({1e3 * s['interpolated']:.2f} against {1e3 * s['simplified']:.2f} "
         f"ms); closed loop (perfect navigation, simplified) {1 / c['closed_over_open_loop']:.2f}x the flights/s "
-        f"of the same flights with the controller off ({1e3 * s['closed_loop']:.2f} ms)"
+        f"of the same flights with the controller off ({1e3 * s['closed_loop']:.2f} ms); on raw sensors "
+        f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost ({1e3 * s['sensors']:.2f} ms)"
     )
     return "\n".join(lines)
 

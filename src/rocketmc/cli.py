@@ -1,6 +1,7 @@
 """The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``compare`` the
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
-a campaign, ``validate`` the simulation against a real flight, ``bench`` this machine."""
+a campaign, ``sensors simulate``: one realization's sensor log, ``validate`` the simulation against a real
+flight, ``bench`` this machine."""
 
 from __future__ import annotations
 
@@ -26,9 +27,9 @@ class _Parser(argparse.ArgumentParser):
 def _run(args) -> int:
     from .campaign import run_chunks
 
-    controller = None if args.controller is None else args.controller == "on"
+    controller, sensors = (None if switch is None else switch == "on" for switch in (args.controller, args.sensors))
     campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model,
-                         controller=controller)  # fmt: skip
+                         controller=controller, sensors=sensors)  # fmt: skip
     if args.scheduler is None and args.workers is None:
         return _fly(args, campaign, run_chunks)
     try:
@@ -273,6 +274,23 @@ def _gnc_design(args) -> int:
     return 0
 
 
+def _sensors_simulate(args) -> int:
+    from .analysis.sensor_log import LOG_FILES, write_sensor_log
+    from .campaign.sensor_record import sensor_record
+
+    campaign = _campaign(args.campaign)
+    what = f"{args.static:g} s at rest on the pad" if args.static else "its flight"
+    if not args.quiet:
+        print(f"{campaign.config.name}: realization {args.realization}, {what} (compiling, then flying)", file=sys.stderr)
+    logs = sensor_record(campaign, args.realization, args.static)
+    write_sensor_log(args.out, logs)
+    for name, frame in logs.items():
+        print(f"wrote {Path(args.out) / LOG_FILES[name][0]}: {len(frame)} samples", file=sys.stderr)
+    return 0
+
+
+MAX_STATIC_S = 86_400.0
+"""Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
 MAX_MACH = 10.0
 """Largest Mach number ``aero derivatives`` evaluates at (tables are clamped at their edge beyond theirs)."""
 FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
@@ -348,6 +366,9 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--controller", choices=("on", "off"),
                      help="off: the same flights with the canards neutral (no [gnc]); on: the campaign's [gnc], "
                           "or its defaults if it has none")  # fmt: skip
+    run.add_argument("--sensors", choices=("on", "off"),
+                     help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
+                          "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
     cluster = run.add_mutually_exclusive_group()
     cluster.add_argument("--scheduler", metavar="ADDRESS",
                          help="fly the chunks on the Dask cluster of this scheduler (tcp://host:8786; needs "
@@ -382,6 +403,17 @@ def main(argv: list[str] | None = None) -> int:
     design.add_argument("--plot", help="write the main gains and spectral radius against speed to this PNG")
     design.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                         help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    sensors = commands.add_parser("sensors", help="the simulated sensors of a campaign")
+    sensors_commands = sensors.add_subparsers(dest="sensors_command", required=True, parser_class=_Parser)
+    simulate = sensors_commands.add_parser(
+        "simulate", help="one realization's sensor outputs, as CSV files like the real Lynx log's")
+    simulate.add_argument("campaign", help="campaign file (TOML) with an [avionics] section")
+    simulate.add_argument("--realization", type=int, default=0, metavar="I",
+                          help="the realization whose drawn errors and gusts are flown (default 0)")  # fmt: skip
+    simulate.add_argument("--static", type=float, metavar="SECONDS",
+                          help="instead, the rocket at rest on the pad for this long (noise analysis)")  # fmt: skip
+    simulate.add_argument("--out", required=True, metavar="DIR", help="folder for the CSV files")
+    simulate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
     validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
@@ -419,11 +451,13 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
     if (getattr(args, "workers", None) or 0) > CORES:
         parser.error(f"--workers must be at most the {CORES} core(s) of this machine (one process per core)")
+    if args.command == "sensors" and (args.realization < 0 or not 0 < (args.static or 1.0) <= MAX_STATIC_S):
+        parser.error(f"--realization must be at least 0 and --static in (0, {MAX_STATIC_S:g}] s")
     if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
         parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
                      f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
-               "validate": _validate, "bench": _bench}  # fmt: skip
+               "sensors": _sensors_simulate, "validate": _validate, "bench": _bench}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

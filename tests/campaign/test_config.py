@@ -31,6 +31,39 @@ DEFAULTS = {
     "rocket.geometry.canards.cant_deg": 0.0, "rocket.geometry.canards.first_panel_deg": 0.0,
     "rocket.parachutes.*.opening_time_s": 0.0, "environment.wind.speed_scale": 1.0,
 }  # fmt: skip
+PARTS = ROCKETS.parent / "sensors"
+SENSOR_DEFAULTS = {
+    "bias.*": 0.0, "bias_std.*": 0.0, "bias_walk": 0.0, "scale_factor.*": 0.0, "scale_factor_std": 0.0, "cross_axis.*": 0.0,
+    "cross_axis_std": 0.0, "misalignment_deg.*": 0.0, "misalignment_std_deg": 0.0, "mounting_deg.*": 0.0,
+    "hard_iron.*": 0.0, "hard_iron_std": 0.0, "latency_s": 0.0, "sinusoid_amplitude_m.*": 0.0,
+    "sinusoid_frequency_hz": 0.0, "sinusoid_phase_deg.*": 0.0, "first_fix_s": 0.0, "vibration_per_kpa.*": 0.0,
+}  # fmt: skip
+"""Numbers a sensor's part and table may leave out (by the field's path in the sensor's table) and their defaults;
+the soft-iron matrix defaults to the identity."""
+
+
+def _avionics(avionics: dict) -> dict:
+    """The [avionics] table with each sensor's part (data/sensors/<part>.toml, read here with tomllib) under
+    the sensor's own table: its own part, else the section's if that part has the sensor, else the thesis's."""
+    sensors = ("accelerometer", "gyroscope", "magnetometer", "barometer", "gnss", "canard_feedback")
+    section = tomllib.loads((PARTS / f"{avionics.get('part', 'thesis')}.toml").read_text())
+    merged = {}
+    for sensor in sensors:
+        own = avionics.get(sensor, {})
+        name = own.get("part", avionics.get("part", "thesis") if sensor in section else "thesis")
+        part = tomllib.loads((PARTS / f"{name}.toml").read_text())[sensor]
+        if "noise_density" in own or "noise_std" in own:  # the table's own kind of white noise replaces the part's
+            part = {k: v for k, v in part.items() if k not in ("noise_density", "noise_std")}
+        merged[sensor] = {**part, **own}
+    return merged
+
+
+def _sensor_default(key: str):
+    """The default of ``avionics.<sensor>.<field>...`` numbers a part leaves out, or None."""
+    field = re.sub(r"\.\d+$", ".*", key.split(".", 2)[2])
+    if field == "soft_iron.*":
+        return [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0][int(key.rsplit(".", 1)[1])]
+    return SENSOR_DEFAULTS.get(field)
 
 
 def _flat(tree, prefix=""):
@@ -72,12 +105,15 @@ def test_shipped_campaigns_load(path):
     preset = rocket.pop("preset", None)
     if preset is not None:
         rocket = _over(tomllib.loads((ROCKETS / f"{preset}.toml").read_text()), rocket)
-    written = {"rocket": rocket, "launch": data["launch"], "environment": data["environment"], "gnc": data.get("gnc", {})}
+    written = {"rocket": rocket, "launch": data["launch"], "environment": data["environment"], "gnc": data.get("gnc", {}),
+               "avionics": _avionics(data["avionics"]) if "avionics" in data else {}}  # fmt: skip
     numbers = {k: v for k, v in _flat(written).items() if _number(v)}
     assert {k: campaign.nominal.get(k) for k in numbers} == numbers
     defaults = {k: v for k, v in campaign.nominal.items() if k not in numbers}
     gnc_defaults = _flat({"gnc": GncConfig().model_dump()}) if "gnc" in data else {}
-    assert {k: DEFAULTS.get(re.sub(r"\.\d+(?=\.|$)", ".*", k), gnc_defaults.get(k)) for k in defaults} == defaults
+    expected = {k: _sensor_default(k) if k.startswith("avionics.") else
+                DEFAULTS.get(re.sub(r"\.\d+(?=\.|$)", ".*", k), gnc_defaults.get(k)) for k in defaults}  # fmt: skip
+    assert expected == defaults
     loaded = _flat(config.model_dump())
     for key, value in _flat(written).items():  # the words too: model names, files, parachute names
         if not _number(value):
@@ -87,7 +123,16 @@ def test_shipped_campaigns_load(path):
     assert config.site.model_dump() == data["site"]
     simulation = config.simulation.model_dump()
     assert {k: simulation[k] for k in data.get("simulation", {})} == data.get("simulation", {})
-    assert list(config.dispersions) == list(data.get("dispersions", {}))
+    # the file's dispersions, after those its sensors' per-flight spreads imply (normal, about the nominal value)
+    spreads = {f"avionics.{sensor}.{target}.{i}": std
+               for sensor, table in written["avionics"].items() for spread, target in
+               (("bias_std", "bias"), ("scale_factor_std", "scale_factor"), ("cross_axis_std", "cross_axis"),
+                ("misalignment_std_deg", "misalignment_deg"), ("hard_iron_std", "hard_iron")) if spread in table
+               for i, std in enumerate(table[spread] if isinstance(table[spread], list) else
+                                       [table[spread]] * {"cross_axis": 6}.get(target, 3)) if std > 0}  # fmt: skip
+    assert list(config.dispersions) == [*spreads, *(k for k in data.get("dispersions", {}) if k not in spreads)]
+    for key, std in spreads.items():
+        assert config.dispersions[key].model_dump(exclude_none=True) == {"dist": "normal", "std": std}, key
     for key, given in data.get("dispersions", {}).items():
         assert {k: v for k, v in config.dispersions[key].model_dump().items() if v is not None} == given, key
         assert key in campaign.nominal

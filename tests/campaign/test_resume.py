@@ -17,7 +17,7 @@ import numpy as np
 from rocketmc.cli import main
 
 CAMPAIGN = str(Path(__file__).parents[2] / "campaigns" / "lynx_nominal_ctrl_1s.toml")
-ARGS = ["-n", "160", "--chunk-size", "16", "--seed", "5"]  # 10 chunks of ~0.2 s each after compilation
+ARGS = ["-n", "160", "--chunk-size", "16", "--seed", "5", "--sensors", "on"]  # 10 chunks of ~0.2 s each after compilation; the controller on raw sensors
 
 
 def contents(path):

@@ -23,14 +23,35 @@ SERVO_DISPERSIONS = """[dispersions]
 """
 
 
-@pytest.mark.parametrize("name", ["lynx_nominal", "lynx_ballistic_ctrl_1s"])
-def test_same_bits_for_any_chunk_size(name):
+SENSORS = """[avionics]
+part = "bmx160"
+
+[avionics.barometer]
+part = "ms5803_01ba"
+
+[avionics.gnss]
+part = "neo_m9n"
+
+[avionics.canard_feedback]
+part = "thesis"
+noise_std = 0.1
+bias_std = [0.2, 0.2, 0.2, 0.2]
+
+"""
+
+
+@pytest.mark.parametrize("name, sensors", [("lynx_nominal", False), ("lynx_ballistic_ctrl_1s", False),
+                                           ("lynx_ballistic_ctrl_1s", True)])  # fmt: skip
+def test_same_bits_for_any_chunk_size(name, sensors):
     # Chunks of 5 (compiled batches of 16 flights, 8 per core, a padded last chunk) against chunks of
     # 20 (batches of 32): the same realizations with turbulence, mass, thrust and wind draws, open loop,
-    # and with the controller on (perfect navigation) and its servos dispersed.
+    # and with the controller on and its servos dispersed, on perfect navigation and on raw sensors (datasheet
+    # parts: their turn-on biases drawn per flight, their noise per block).
     path = CAMPAIGNS / f"{name}.toml"
-    campaign = parse_campaign(path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if "ctrl" in name else "[dispersions]\n"),
-                              path.parent).with_overrides(n_realizations=24)  # fmt: skip
+    text = path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if "ctrl" in name else "[dispersions]\n")
+    if sensors:
+        text = text.replace('navigation = "truth"', 'navigation = "sensors"').replace("[dispersions]", SENSORS + "[dispersions]")
+    campaign = parse_campaign(text, path.parent).with_overrides(n_realizations=24)
     a_out, a_in = collect(campaign, 5)
     b_out, b_in = collect(campaign, 20)
     assert a_out.keys() == b_out.keys() and a_in.keys() == b_in.keys()
@@ -42,3 +63,5 @@ def test_same_bits_for_any_chunk_size(name):
     assert len(np.unique(a_out["impact_north_m"])) == 24  # the realizations do differ
     if "ctrl" in name:
         assert len(np.unique(a_in["gnc.servo.time_constant_s"])) == 24 and np.all(a_out["control_active_time_s"] > 8.9)
+    if sensors:  # the drawn turn-on biases are inputs, one per axis
+        assert len(np.unique(a_in["avionics.gyroscope.bias.2"])) == 24 and "avionics.canard_feedback.bias.3" in a_in

@@ -15,7 +15,8 @@ from rocketmc.aero.canards import mix
 from rocketmc.campaign.runner import LANES
 from rocketmc.dynamics.servo import ServoParams, ServoState
 from rocketmc.gnc import design
-from rocketmc.gnc.control import GAIN_NAMES, GncParams, GncState, control_summary, gains_at, gnc_step, initial_gnc, lqi_command
+from rocketmc.gnc import control
+from rocketmc.gnc.control import GAIN_NAMES, GncParams, GncState, control_summary, gains_at, initial_gnc, lqi_command
 from rocketmc.gnc.guidance import GuidanceParams, Navigation
 from rocketmc.math import Quat, Vec3
 from rocketmc.math.table import Table
@@ -32,6 +33,11 @@ def thesis_point(speed, altitude_msl):
         -24.0744, 154.0, 3.4045, 24.0744, 154.0, 3.4045, -19.0, 2.3963, -37.2959, -1813.0, 21.8445,
         37.2959, -1813.0, 21.8445, 22.0, 0.06, 6.437, math.pi * 0.15**2 / 4, 0.15, speed, design.density(altitude_msl),
     )  # fmt: skip
+
+
+def gnc_step(params, state, nav: Navigation, *rest):
+    """``control.gnc_step`` with perfect navigation's liftoff test: the rocket moves once its velocity is not zero."""
+    return control.gnc_step(params, state, nav, nav.v_n.dot(nav.v_n) > 0.0, *rest)
 
 
 SPEEDS = np.array([50.0, 100.0, 200.0, 300.0])

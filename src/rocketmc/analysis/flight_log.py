@@ -93,8 +93,9 @@ class FlightLog:
     description: str
 
 
-def _read_stream(path: Traversable, period_s: float, columns: dict[str, str]) -> pd.DataFrame:
-    """One CSV stream as ``t_s`` plus ``columns`` renamed; errors name the file."""
+def _read_stream(path: Traversable, period_s: float | None, columns: dict[str, str]) -> pd.DataFrame:
+    """One CSV stream as ``t_s`` plus ``columns`` renamed; errors name the file. ``period_s`` None:
+    the last ``t_nominal_s`` / (rows − 1)."""
     if not path.is_file():
         raise FileNotFoundError(f"{path}: flight log file not found")
     try:
@@ -110,6 +111,10 @@ def _read_stream(path: Traversable, period_s: float, columns: dict[str, str]) ->
         raise ValueError(f"{path}: every row needs finite numbers in {', '.join(needed)}")
     if not np.array_equal(values["sample"], np.arange(len(values))):
         raise ValueError(f"{path}: sample must count 0, 1, 2, ... without gaps")
+    if period_s is None:
+        if len(values) < 2:
+            raise ValueError(f"{path}: two samples or more needed for the period")
+        period_s = float(values["t_nominal_s"].iloc[-1]) / (len(values) - 1)
     t_s = values["sample"].to_numpy() * period_s
     if not np.allclose(values["t_nominal_s"], t_s, rtol=0.0, atol=1e-3):
         raise ValueError(f"{path}: t_nominal_s is not sample × {period_s} s")

@@ -12,7 +12,7 @@ import hashlib
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
@@ -28,11 +28,13 @@ from ..errors import RocketmcError
 from ..gnc.design import Schedule
 from ..env.wind import POWER_LAW_FLOOR_M, read_wind_profile
 from ..math.table import Table
+from ..sensors.parts import load_part, part_names
+from ..sim.params import SimSettings
 
 if TYPE_CHECKING:
     from .gains import DesignInputs
 
-DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment", "gnc")
+DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment", "gnc", "avionics")
 FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "rocket.geometry.", "rocket.aero.")
 """Numbers that define the body frame or build the aerodynamic tables once per campaign: not
 dispersible, except those of ``DISPERSIBLE_AERO``."""
@@ -40,6 +42,9 @@ DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.li
 FIXED_GNC = ("gnc.guidance.", "gnc.control.")
 """Guidance and the gain design, set once per campaign (the gains are designed when it loads): not
 dispersible; the servos (``gnc.servo``) are."""
+FIXED_AVIONICS = ("rate_hz", "latency_s", *("_std", "_std_deg"))
+"""Ends of the avionics' numbers that are not dispersible: the schedule (rate, latency) is set per campaign,
+and the per-flight spreads are dispersions themselves."""
 ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
 
 # Physical ranges (docs/conventions.md, Campaign validation): every number is finite and within these, generous
@@ -72,6 +77,10 @@ MAX_CANARD_LIMIT_DEG = 45.0  # canards stall beyond ~20°: 45° is a unit slip, 
 MAX_SERVO_RATE_DEG_S = 10_000.0  # servos slew 60-1000 °/s
 MAX_RATE_DEG_S = 3600.0  # commanded body rates: ten turns a second is no guidance
 MAX_GUIDANCE_GAIN = 1000.0  # guidance [1/s] and integrator [-] gains: 200 × the thesis's; k·T ≫ 1 oscillates
+MAX_SENSOR_VALUE = 1e7  # any sensor's unit (m/s², deg/s, µT, Pa, deg): 1e7 Pa is 100 atmospheres
+MAX_SENSOR_LATENCY_S = 1.0  # a sensor later than a second is a logger, not a GNC input
+MAX_MISALIGNMENT_DEG = 10.0  # a sensor more than 10° off its mount is mounted elsewhere
+MAX_LENGTH_KM = 100.0  # GNSS errors: 100 km is no fix
 MAX_LQ_WEIGHT = 1e12  # LQI weights: only their ratios matter, and the DARE loses accuracy beyond 1e12 apart
 DEFAULT_SPEEDS_MPS = [20.0, 30.0, 40.0, 60.0, 80.0, 100.0, 150.0, 200.0, 250.0, 300.0]
 DEFAULT_ALTITUDES_M = [0.0, 1000.0, 2000.0]
@@ -535,12 +544,213 @@ class ControlConfig(_Strict):
 
 
 class GncConfig(_Strict):
-    """The closed loop: canard servos, guidance, LQI control; navigation "truth" (the true state)."""
+    """The closed loop: canard servos, guidance, LQI control; navigation "truth" (the true state) or "sensors"
+    (raw sensors from the avionics bus: gyro rates, GNSS fixes held between fixes, the launch attitude
+    propagated by the gyro; needs [avionics])."""
 
-    navigation: Literal["truth"] = "truth"
+    navigation: Literal["truth", "sensors"] = "truth"
     servo: ServoConfig = ServoConfig()
     guidance: GuidanceConfig = GuidanceConfig()
     control: ControlConfig = ControlConfig()
+
+
+DEFAULT_PART = "thesis"
+"""The part of a sensor no part is named for: the thesis's set provides every sensor (GNC.md §1)."""
+SensorValue = Annotated[float, Field(ge=-MAX_SENSOR_VALUE, le=MAX_SENSOR_VALUE)]
+SensorSpread = Annotated[float, Field(ge=0, le=MAX_SENSOR_VALUE)]
+
+
+class _SensorConfig(_Strict):
+    """What every sensor has: its part (data/sensors/<part>.toml, whose values the other fields override),
+    its sampling rate [Hz] (dividing the GNC rate), its latency [s] (a multiple of the GNC period) and a
+    switch to turn its errors off (the truth at each sample, on the same schedule)."""
+
+    part: str
+    truth_only: bool = False
+    rate_hz: float = Field(gt=0, le=1.0 / MIN_CONTROL_DT_S)
+    latency_s: float = Field(0.0, ge=0, le=MAX_SENSOR_LATENCY_S)
+
+
+class ChannelConfig(_SensorConfig):
+    """A channel of ``AXES`` axes in the sensor's unit (docs/sensors.md): range [low, high], LSB (0: no
+    quantisation), white noise as a density [unit/√Hz] or per sample [unit] (one of the two), the constant
+    bias and the standard deviation of its per-flight draw [unit] per axis, the bias instability as a rate
+    random walk [unit/√s], the airframe's vibration per axis (white noise per sample that grows with the
+    dynamic pressure [unit per kPa], its variance added to the sensor's own), the scale-factor error [-] per
+    axis and its per-flight spread."""
+
+    AXES: ClassVar[int] = 3
+    VECTORS: ClassVar[tuple[str, ...]] = ("bias", "bias_std", "scale_factor", "vibration_per_kpa")
+
+    range: list[SensorValue] = Field(min_length=2, max_length=2)
+    lsb: SensorSpread
+    noise_density: SensorSpread | None = None
+    noise_std: SensorSpread | None = None
+    bias: list[SensorValue]
+    bias_std: list[SensorSpread]
+    bias_walk: SensorSpread = 0.0
+    vibration_per_kpa: list[SensorSpread]
+    scale_factor: list[Annotated[float, Field(ge=-0.5, le=0.5)]]
+    scale_factor_std: Annotated[float, Field(ge=0, le=0.1)] = 0.0
+
+    @model_validator(mode="before")
+    @classmethod
+    def _zero_vectors(cls, data):
+        """The per-axis fields default to zeros of the channel's size."""
+        if isinstance(data, dict):
+            data = {**{name: [0.0] * cls._size(name) for name in cls.VECTORS}, **data}
+        return data
+
+    @classmethod
+    def _size(cls, name: str) -> int:
+        return cls.AXES
+
+    @model_validator(mode="after")
+    def _shape(self):
+        for name in self.VECTORS:
+            if len(getattr(self, name)) != self._size(name):
+                raise ValueError(f"{name} must have {self._size(name)} values, got {len(getattr(self, name))}")
+        if (self.noise_density is None) == (self.noise_std is None):
+            raise ValueError("give the white noise either as noise_density [unit/√Hz] or as noise_std [unit per sample]")
+        low, high = self.range
+        if not low < high:
+            raise ValueError(f"range must be [low, high] with low < high, got {self.range}")
+        return self
+
+
+class RateChannelConfig(ChannelConfig):
+    """A channel that measures a signed quantity: its range contains zero."""
+
+    @model_validator(mode="after")
+    def _contains_zero(self):
+        if not self.range[0] <= 0.0 <= self.range[1]:
+            raise ValueError(f"range must contain zero, got {self.range}")
+        return self
+
+
+class InertialConfig(RateChannelConfig):
+    """A 3-axis sensor on the airframe: its cross-axis couplings (xy, xz, yx, yz, zx, zy) [-] and their
+    per-flight spread, its misalignment (3-2-1 angles about z, y, x [deg], unknown to the avionics) and its
+    spread, its mounting (3-2-1 angles from the body frame to the sensor's [deg], known to the avionics), and
+    where it sits: [x along the rocket's axis in the rocket's coordinates, y, z across it in the body frame] [m]
+    (None: at the reference point)."""
+
+    VECTORS: ClassVar[tuple[str, ...]] = (*ChannelConfig.VECTORS, "cross_axis", "misalignment_deg", "mounting_deg")
+
+    cross_axis: list[Annotated[float, Field(ge=-0.5, le=0.5)]]
+    cross_axis_std: Annotated[float, Field(ge=0, le=0.1)] = 0.0
+    misalignment_deg: list[Annotated[float, Field(ge=-MAX_MISALIGNMENT_DEG, le=MAX_MISALIGNMENT_DEG)]]
+    misalignment_std_deg: Annotated[float, Field(ge=0, le=MAX_MISALIGNMENT_DEG)] = 0.0
+    mounting_deg: list[Direction]
+    position_m: list[Position] | None = Field(None, min_length=3, max_length=3)
+
+    @classmethod
+    def _size(cls, name: str) -> int:
+        return 6 if name == "cross_axis" else 3
+
+
+class MagnetometerConfig(InertialConfig):
+    """A magnetometer [µT]: also the airframe's hard-iron offset [µT] and its per-flight spread, and its
+    soft-iron matrix (row by row, 9 values [-])."""
+
+    VECTORS: ClassVar[tuple[str, ...]] = (*InertialConfig.VECTORS, "hard_iron", "soft_iron")
+
+    hard_iron: list[SensorValue]
+    hard_iron_std: SensorSpread = 0.0
+    soft_iron: list[Annotated[float, Field(ge=-10, le=10)]]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _identity(cls, data):
+        if isinstance(data, dict) and "soft_iron" not in data:
+            data = {**data, "soft_iron": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]}
+        return data
+
+    @classmethod
+    def _size(cls, name: str) -> int:
+        return 9 if name == "soft_iron" else super()._size(name)
+
+
+class BarometerConfig(ChannelConfig):
+    """A barometer [Pa], one axis: the static pressure at the rocket's altitude."""
+
+    AXES: ClassVar[int] = 1
+
+
+class CanardFeedbackConfig(RateChannelConfig):
+    """The canard servos' position sensors [deg], one per fin."""
+
+    AXES: ClassVar[int] = 4
+
+
+class GnssConfig(_SensorConfig):
+    """A GNSS receiver: NED position and velocity fixes with white noise per fix (N, E, D) [m], [m/s], the slow
+    sinusoidal position bias A·sin(2πft + φ) [m], [Hz], [deg] (its derivative on the velocity), and the time of
+    the first fix [s from t = 0, the rocket on the pad]."""
+
+    position_noise_m: list[Annotated[float, Field(ge=0, le=MAX_LENGTH_KM * 1000)]] = Field(min_length=3, max_length=3)
+    velocity_noise_mps: list[Annotated[float, Field(ge=0, le=MAX_SPEED_MPS)]] = Field(min_length=3, max_length=3)
+    sinusoid_amplitude_m: list[Annotated[float, Field(ge=0, le=MAX_LENGTH_KM * 1000)]] = Field([0.0] * 3, min_length=3, max_length=3)
+    sinusoid_frequency_hz: float = Field(0.0, ge=0, le=1.0)
+    sinusoid_phase_deg: list[Direction] = Field([0.0] * 3, min_length=3, max_length=3)
+    first_fix_s: float = Field(0.0, ge=0, le=MAX_FLIGHT_TIME_S)
+
+
+SENSOR_CONFIGS: dict[str, type[_SensorConfig]] = {
+    "accelerometer": InertialConfig, "gyroscope": InertialConfig, "magnetometer": MagnetometerConfig,
+    "barometer": BarometerConfig, "gnss": GnssConfig, "canard_feedback": CanardFeedbackConfig,
+}  # fmt: skip
+"""Each sensor of the avionics and its schema, in the bus's order."""
+SPREADS = {"bias_std": "bias", "scale_factor_std": "scale_factor", "cross_axis_std": "cross_axis",
+           "misalignment_std_deg": "misalignment_deg", "hard_iron_std": "hard_iron"}  # fmt: skip
+"""A sensor's per-flight spreads and the values they disperse (normal draws about the nominal value)."""
+
+
+class AvionicsConfig(_Strict):
+    """The sensors (docs/sensors.md): each from a part (``part``: the default of every sensor it provides, the
+    others the thesis's; a sensor's own ``part`` picks another), with any field overridden in its own table;
+    ``truth_only``: every sensor's errors off."""
+
+    part: str = DEFAULT_PART
+    truth_only: bool = False
+    accelerometer: InertialConfig = Field(default_factory=dict, validate_default=True)
+    gyroscope: InertialConfig = Field(default_factory=dict, validate_default=True)
+    magnetometer: MagnetometerConfig = Field(default_factory=dict, validate_default=True)
+    barometer: BarometerConfig = Field(default_factory=dict, validate_default=True)
+    gnss: GnssConfig = Field(default_factory=dict, validate_default=True)
+    canard_feedback: CanardFeedbackConfig = Field(default_factory=dict, validate_default=True)
+
+    @field_validator(*SENSOR_CONFIGS, mode="before")
+    @classmethod
+    def _from_part(cls, own, info: ValidationInfo):
+        """The part's values under the sensor's own."""
+        if not isinstance(own, dict):
+            return own
+        default = info.data.get("part", DEFAULT_PART)
+        if default in part_names() and info.field_name not in load_part(default):
+            default = DEFAULT_PART  # the section's part provides other sensors: this one is the thesis's
+        name = own.get("part", default)
+        if not isinstance(name, str):
+            raise ValueError(f"part: expected a part name, got {_shown(name)}")
+        try:
+            part = load_part(name)
+        except KeyError:
+            raise ValueError(f"unknown part {_shown(name)} (known: {', '.join(part_names(info.field_name))})") from None
+        if info.field_name not in part:
+            raise ValueError(f"part {name!r} has no {info.field_name} (parts with one: "
+                             f"{', '.join(part_names(info.field_name))})")  # fmt: skip
+        values = dict(part[info.field_name])
+        for given, other in (("noise_density", "noise_std"), ("noise_std", "noise_density")):
+            if given in own:  # the table's own kind of white noise replaces the part's
+                values.pop(other, None)
+        return {"truth_only": info.data.get("truth_only", False), **values, **own, "part": name}
+
+    @field_validator("part")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if name not in part_names():
+            raise ValueError(f"not a known part (known: {', '.join(part_names())})")
+        return name
 
 
 class CampaignConfig(_Strict):
@@ -555,6 +765,7 @@ class CampaignConfig(_Strict):
     dispersions: dict[str, Dispersion] = {}
     simulation: SimulationConfig = SimulationConfig()
     gnc: GncConfig | None = Field(None, description="the closed loop; None: no controller, canards neutral")
+    avionics: AvionicsConfig | None = Field(None, description="the sensors; None: no sensors simulated")
 
     @field_validator("name")
     @classmethod
@@ -589,25 +800,33 @@ class Campaign:
 
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
-        controller: bool | None = None,
+        controller: bool | None = None, sensors: bool | None = None,
     ) -> Campaign:  # fmt: skip
         """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
         True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
-        (the same flights with the canards neutral)."""
+        (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
+        (the thesis's parts) if there is none and flies the controller on raw sensors, False removes it and its
+        dispersions and flies the controller on perfect navigation."""
         data = self.config.model_dump()
         data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
         if aero_model is not None:
             data["rocket"]["aero"]["model"] = aero_model
-        if controller is not None and controller != (self.config.gnc is not None):
-            data["gnc"] = {} if controller else None
-            data["dispersions"] = {k: d for k, d in data["dispersions"].items() if controller or not k.startswith("gnc.")}
+        for section, on in (("gnc", controller), ("avionics", sensors)):
+            if on is not None and on != (data[section] is not None):
+                data[section] = {} if on else None
+                data["dispersions"] = {k: d for k, d in data["dispersions"].items() if on or not k.startswith(section + ".")}
+        if sensors is not None and data["gnc"] is not None:
+            data["gnc"]["navigation"] = "sensors" if sensors else "truth"
         config = _validate(data)
+        _check_avionics(config)
+        config = config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
         campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
         new_aero = config.rocket.aero.model != self.config.rocket.aero.model
         if new_aero:
             campaign = dataclasses.replace(campaign, aero=_aero_model(config.rocket, self.base_dir),
                                            files=_file_digests(config, self.base_dir))  # fmt: skip
-        if new_aero or config.gnc != self.config.gnc:
+        design = lambda c: None if c.gnc is None else c.gnc.model_dump(exclude={"navigation"})  # noqa: E731
+        if new_aero or design(config) != design(self.config):
             campaign = _with_gains(campaign)
         return campaign
 
@@ -739,6 +958,9 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
         if path.startswith(FIXED_PER_CAMPAIGN) and not path.startswith(DISPERSIBLE_AERO):
             raise ConfigError(f"{field}: fixed for the whole campaign (it defines the body frame or builds the "
                               "aerodynamic tables); disperse rocket.aero.drag_scale or rocket.aero.cl0 instead")  # fmt: skip
+        if path.startswith("avionics.") and path.rstrip("0123456789.").endswith(FIXED_AVIONICS):
+            raise ConfigError(f"{field}: fixed for the whole campaign (a sensor's schedule is set once, and its "
+                              "per-flight spreads are dispersions already)")  # fmt: skip
         if path.startswith(FIXED_GNC):
             raise ConfigError(f"{field}: fixed for the whole campaign (guidance and the LQI gains are set once, "
                               "when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
@@ -786,11 +1008,63 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
             raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
                               f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
 
+    _check_avionics(config)
+    config = config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
     nominal = _nominal_values(config)
     _check_dispersions(config, nominal)
     aero = _aero_model(config.rocket, base_dir)
     return _with_gains(Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir,
                                 _wind_profile(config, base_dir), _file_digests(config, base_dir)))  # fmt: skip
+
+
+def sensor_ticks(config: CampaignConfig, seconds: float, field: str) -> int:
+    """``seconds`` as a whole number of GNC periods (``simulation.control_dt_s``); ConfigError naming
+    ``field`` if it is not one."""
+    dt = config.simulation.control_dt_s
+    ticks = round(seconds / dt)
+    if abs(ticks * dt - seconds) > 1e-9 * max(seconds, dt):
+        raise ConfigError(f"{field}: {seconds:g} s is not a whole number of GNC periods "
+                          f"(simulation.control_dt_s = {dt:g} s)")  # fmt: skip
+    return ticks
+
+
+def sample_period_ticks(config: CampaignConfig, sensor: str) -> int:
+    """The GNC periods between two samples of ``sensor``; ConfigError unless its rate divides the GNC rate into a
+    divisor of ``SimSettings.block_steps`` (a sensor's noise is drawn a block at a time, for its samples only)."""
+    dt, rate = config.simulation.control_dt_s, getattr(config.avionics, sensor).rate_hz
+    every = round(1.0 / (rate * dt))
+    if every < 1 or abs(every * rate * dt - 1.0) > 1e-9 or SimSettings.block_steps % every:
+        rates = ", ".join(f"{1 / (k * dt):g}" for k in (1, 2, 5, 10))
+        raise ConfigError(f"avionics.{sensor}.rate_hz: {rate:g} Hz does not divide the GNC rate ({1 / dt:g} Hz, "
+                          f"simulation.control_dt_s = {dt:g} s) into a divisor of {SimSettings.block_steps} GNC "
+                          f"periods (the noise blocks): e.g. {rates} Hz")  # fmt: skip
+    return every
+
+
+def _check_avionics(config: CampaignConfig) -> None:
+    """Sensor rates divide the GNC rate, latencies are whole GNC periods, raw-sensor navigation has sensors."""
+    if config.gnc is not None and config.gnc.navigation == "sensors" and config.avionics is None:
+        raise ConfigError("gnc.navigation: 'sensors' needs an [avionics] section (the sensors it reads)")
+    for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
+        sample_period_ticks(config, sensor)
+        sensor_ticks(config, getattr(config.avionics, sensor).latency_s, f"avionics.{sensor}.latency_s")
+
+
+def sensor_spreads(config: CampaignConfig) -> dict[str, Dispersion]:
+    """The normal dispersions the sensors' per-flight spreads (``SPREADS``) imply, by dotted path: each axis
+    of a value about its nominal value."""
+    spreads = {}
+    for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
+        values = getattr(config.avionics, sensor)
+        for spread, target in SPREADS.items():
+            stds = getattr(values, spread, None)
+            if stds is None:
+                continue
+            nominal = getattr(values, target)
+            for i, std in enumerate(stds if isinstance(stds, list) else [stds] * len(nominal)):
+                if std > 0.0:
+                    spreads[f"avionics.{sensor}.{target}.{i}"] = Dispersion(dist="normal", std=std)
+    return spreads
 
 
 def _nominal_values(config: CampaignConfig) -> dict[str, float]:

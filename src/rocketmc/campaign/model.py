@@ -21,10 +21,14 @@ from ..dynamics.servo import ServoParams
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
 from ..gnc.control import GAIN_NAMES, GncParams
 from ..gnc.guidance import GuidanceParams
-from ..math import Vec3
+from ..math import Quat, Vec3
 from ..math.table import Table
+from ..env.magnetic import site_field_ned
+from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
+from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
+from ..sensors.parts import SENSORS
 from ..sim.params import Environment, FlightParams, Launch, Rocket
-from .config import Campaign
+from .config import Campaign, sample_period_ticks, sensor_ticks
 from .sampling import realization_key, stream_key
 
 
@@ -130,7 +134,7 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
         wind=_wind(campaign, v),
         turbulence=_turbulence(campaign, v, key),
     )
-    return FlightParams(rocket, launch, environment, _gnc(campaign, v))
+    return FlightParams(rocket, launch, environment, _gnc(campaign, v), _avionics(campaign, v, key, body_x, aero.n_canards))
 
 
 def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
@@ -164,7 +168,89 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
         table = Table.from_numpy((schedule.speeds, schedule.altitudes), gains, ("speed", "altitude"), GAIN_NAMES)
     else:
         table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
-    return GncParams(servo, guidance, table, gnc.control.anti_windup)
+    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation)
+
+
+SENSOR_UNITS = {"accelerometer": 1.0, "gyroscope": math.pi / 180.0, "magnetometer": 1e-6, "barometer": 1.0,
+                "canard_feedback": math.pi / 180.0}  # fmt: skip
+"""Each channel's config unit in SI: m/s², deg/s → rad/s, µT → T, Pa, deg → rad (docs/sensors.md)."""
+
+
+def _rotation(yaw, pitch, roll):
+    """The (3, 3) matrix from a frame to one turned by the 3-2-1 angles [rad] about z, y, x (vectors' new
+    components: the rows are the new axes in the old frame)."""
+    q = Quat.from_euler(yaw, pitch, roll)
+    return jnp.stack([q.rotate_inverse(Vec3(*e)).to_array() for e in jnp.eye(3)], axis=1)
+
+
+def _channel(campaign: Campaign, v: Mapping, sensor: str) -> Channel:
+    """The error model of ``sensor``'s channel from the (possibly drawn) values ``v``, in SI."""
+    config = campaign.config
+    c = getattr(config.avionics, sensor)
+    path, unit, n = f"avionics.{sensor}", SENSOR_UNITS[sensor], len(c.bias)
+
+    def drawn(field: str) -> bool:  # not zero in some flight: an error that is zero in all costs nothing (None)
+        return campaign.nominal[f"{path}.{field}"] != 0.0 or f"{path}.{field}" in config.dispersions
+
+    rate, density = c.rate_hz, c.noise_density is not None
+    white = noise_per_sample(v[f"{path}.noise_density"], rate) if density else v[f"{path}.noise_std"]
+    mounted = hasattr(c, "cross_axis")
+    errors = [f"scale_factor.{i}" for i in range(n)] + (
+        [f"cross_axis.{i}" for i in range(6)] + [f"misalignment_deg.{i}" for i in range(3)] if mounted else [])
+    gain = jnp.diag(1.0 + _vector(v, f"{path}.scale_factor", n)) if any(map(drawn, errors)) else None
+    shaking = [f"vibration_per_kpa.{i}" for i in range(n)]
+    if mounted and gain is not None:
+        xy, xz, yx, yz, zx, zy = (v[f"{path}.cross_axis.{i}"] for i in range(6))
+        one = jnp.ones_like(xy)
+        coupling = jnp.stack([jnp.stack([one, xy, xz]), jnp.stack([yx, one, yz]), jnp.stack([zx, zy, one])])
+        gain = gain @ coupling @ _rotation(*jnp.deg2rad(_vector(v, f"{path}.misalignment_deg", 3)))
+    return Channel(
+        gain=gain,
+        bias=_vector(v, f"{path}.bias", n) * unit,
+        noise_std=white * unit if drawn("noise_density" if density else "noise_std") else None,
+        walk_std=walk_per_sample(v[f"{path}.bias_walk"], rate) * unit if drawn("bias_walk") else None,
+        low=v[f"{path}.range.0"] * unit,
+        high=v[f"{path}.range.1"] * unit,
+        lsb=v[f"{path}.lsb"] * unit,
+        vibration=_vector(v, f"{path}.vibration_per_kpa", n) * unit / 1000.0 if any(map(drawn, shaking)) else None,
+        every=sample_period_ticks(config, sensor),
+        delay=sensor_ticks(config, c.latency_s, f"{path}.latency_s"),
+        ideal=c.truth_only,
+    )
+
+
+def _avionics(campaign: Campaign, v: Mapping, key, body_x, n_canards: int) -> Avionics | None:
+    """The sensors from the campaign's [avionics] (None without it), from the (possibly drawn) values ``v``; the
+    keys of their noise streams ``avionics.<sensor>`` from the realization's ``key``; ``body_x``: a position
+    in the rocket's coordinates (dotted path) to body-frame x [m]; no canard feedback without canards."""
+    config, site = campaign.config.avionics, campaign.config.site
+    if config is None:
+        return None
+
+    def mounted(sensor: str) -> Mounted:
+        path = f"avionics.{sensor}"
+        rotation = _rotation(*jnp.deg2rad(_vector(v, f"{path}.mounting_deg", 3)))
+        position = jnp.zeros(3)
+        if getattr(config, sensor).position_m is not None:
+            position = jnp.stack([body_x(f"{path}.position_m.0"), v[f"{path}.position_m.1"], v[f"{path}.position_m.2"]])
+        return Mounted(_channel(campaign, v, sensor), rotation, position)
+
+    m, g = "avionics.magnetometer", "avionics.gnss"
+    with jax.ensure_compile_time_eval():  # the site's numbers: a constant of the flight, even under jit
+        field_t = 1e-9 * site_field_ned(site.latitude_deg, site.longitude_deg, site.altitude_m)
+    magnetometer = Magnetometer(mounted("magnetometer"), jnp.asarray(field_t), _vector(v, f"{m}.soft_iron", 9).reshape(3, 3),
+                                1e-6 * _vector(v, f"{m}.hard_iron", 3))  # fmt: skip
+    fix_noise = jnp.concatenate([_vector(v, f"{g}.position_noise_m", 3), _vector(v, f"{g}.velocity_noise_mps", 3)])
+    receiver = Channel(
+        gain=None, bias=jnp.zeros(6), noise_std=fix_noise, walk_std=None, low=jnp.asarray(-jnp.inf),
+        high=jnp.asarray(jnp.inf), lsb=jnp.asarray(0.0), every=sample_period_ticks(campaign.config, "gnss"),
+        delay=sensor_ticks(campaign.config, config.gnss.latency_s, f"{g}.latency_s"), ideal=config.gnss.truth_only,
+    )  # fmt: skip
+    gnss = Gnss(receiver, _vector(v, f"{g}.sinusoid_amplitude_m", 3), v[f"{g}.sinusoid_frequency_hz"],
+                jnp.deg2rad(_vector(v, f"{g}.sinusoid_phase_deg", 3)), v[f"{g}.first_fix_s"])  # fmt: skip
+    keys = {name: stream_key(key, f"avionics.{name}") for name in SENSORS}
+    return Avionics(mounted("accelerometer"), mounted("gyroscope"), magnetometer, _channel(campaign, v, "barometer"),
+                    gnss, _channel(campaign, v, "canard_feedback") if n_canards else None, keys)  # fmt: skip
 
 
 def _wind(campaign: Campaign, v: Mapping):

@@ -20,10 +20,11 @@ import jax.numpy as jnp
 from ..aero.canards import allocate, mix
 from ..dynamics.rigid_body import RigidBodyState
 from ..dynamics.servo import ServoParams, ServoState, hold_command
-from ..math import Vec3
+from ..math import Quat, Vec3
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
 from .design import N_INPUT, N_PLANT, N_STATE
+from .navigation import DeadReckoning, initial_dead_reckoning
 from .guidance import GuidanceParams, Navigation, guidance_active, integrate_errors, rate_command
 
 GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
@@ -36,12 +37,13 @@ class GncParams:
     """servo: the canard servos; guidance: the reference and the rate command; gains: ``Table`` of K over
     ``speed`` (axial body speed u [m/s]) and, when the design grid has several, ``altitude`` (above mean sea
     level [m]), outputs ``GAIN_NAMES`` (clamped at the grid's edges); anti_windup: conditional integration
-    (``gnc_step``; static)."""
+    (``gnc_step``; static); navigation: "truth" or "sensors" (``gnc.navigation``; static)."""
 
     servo: ServoParams
     guidance: GuidanceParams
     gains: Table
     anti_windup: bool = static_field(default=True)
+    navigation: str = static_field(default="truth")
 
 
 @pytree_dataclass
@@ -51,7 +53,7 @@ class GncState:
     commands (yaw, pitch, roll) [rad]; saturated: they clipped a fin at its limit (bool). Flight totals for the outputs: active_time [s] with the controller
     active; tracking_sq, ∫χ² dt [rad²·s], and deflection_sq, ∫ mean over the fins of δ² dt [rad²·s], over that
     time; saturated_time [s] active with a fin saturated; max_deflection, the largest |δ| of any fin at a
-    period start [rad]."""
+    period start [rad]. navigation: the raw-sensor navigation's state (``gnc.navigation``; None with "truth")."""
 
     servo: ServoState
     integrators: Vec3
@@ -63,17 +65,20 @@ class GncState:
     deflection_sq: jnp.ndarray
     saturated_time: jnp.ndarray
     max_deflection: jnp.ndarray
+    navigation: DeadReckoning | None = None
 
 
-def initial_gnc(params: GncParams, like) -> GncState:
+def initial_gnc(params: GncParams, like, q_nb0: Quat | None = None) -> GncState:
     """At rest on the rail: servos at their zero, integrators empty, no liftoff yet; ``like`` a scalar of the
-    flight's dtype."""
+    flight's dtype; q_nb0: the launch attitude, where raw-sensor navigation starts (``params.navigation``
+    "sensors")."""
     zero = jnp.zeros_like(like)
     fins = jnp.zeros_like(params.servo.offset_rad)
+    navigation = initial_dead_reckoning(q_nb0) if params.navigation == "sensors" else None
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),
-        zero, zero, zero, zero, zero,
+        zero, zero, zero, zero, zero, navigation,
     )  # fmt: skip
 
 
@@ -102,17 +107,17 @@ def unwinding_only(k, state: GncState, stepped: Vec3) -> Vec3:
     return Vec3(*kept)
 
 
-def gnc_step(params: GncParams, state: GncState, nav: Navigation, t, dt, altitude_msl, canopy) -> GncState:
+def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt, altitude_msl, canopy) -> GncState:
     """The GNC at a period start t [s] (simulation clock): liftoff detection, guidance, integrators, LQI,
     allocation, the command held by the servos, and the totals of the period dt [s] (the GNC period: the
-    controller is never active in the longer descent periods). nav: the navigation solution; altitude_msl:
-    its altitude [m]; canopy: a parachute has been triggered (bool).
+    controller is never active in the longer descent periods). nav: the navigation solution; moving: the
+    navigation sees the rocket off the pad (bool; the first such period start is liftoff); altitude_msl: its
+    altitude [m]; canopy: a parachute has been triggered (bool).
 
     Anti-windup (``params.anti_windup``), conditional integration per axis: while the last command saturated
     a fin, an integrator steps only if its step moves its own virtual command (roll for e_p, pitch for e_q,
     yaw for e_r) back toward zero. Holding every integrator instead latches: an integrator whose own value
     saturates the fins could never unwind."""
-    moving = nav.v_n.dot(nav.v_n) > 0.0
     liftoff_time = jnp.where(jnp.isinf(state.liftoff_time) & moving, t, state.liftoff_time)
     since_liftoff = t - liftoff_time  # −inf before liftoff: outside any window
     active = guidance_active(params.guidance, since_liftoff) & ~canopy
@@ -145,12 +150,13 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, t, dt, altitud
         state.deflection_sq + jnp.mean(deflection * deflection) * active_dt,
         state.saturated_time + jnp.where(saturated, active_dt, 0.0),
         functools.reduce(jnp.maximum, [jnp.abs(d) for d in deflections], state.max_deflection),
+        state.navigation,
     )
 
 
-def truth(body: RigidBodyState) -> Navigation:
-    """Perfect navigation (``navigation = "truth"``): the vehicle's true state."""
-    return Navigation(body.r_n, body.v_n, body.q_nb, body.omega_b)
+def truth(body: RigidBodyState) -> tuple[Navigation, jnp.ndarray]:
+    """Perfect navigation (``navigation = "truth"``): the vehicle's true state, and whether it moves."""
+    return Navigation(body.r_n, body.v_n, body.q_nb, body.omega_b), body.v_n.dot(body.v_n) > 0.0
 
 
 def control_summary(state: GncState) -> dict:

@@ -25,7 +25,9 @@ from ..env import (
 )  # fmt: skip
 from ..env.atmosphere import MAX_ALTITUDE_M
 from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, truth
+from ..gnc.navigation import dead_reckoning, liftoff_sensed
 from ..math import Quat, Vec3, rk4_step
+from ..sensors.avionics import AvionicsState, avionics_noise, initial_avionics, sense, sense_acceleration, specific_force_b
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
 
@@ -88,8 +90,8 @@ class Events:
 class FlightState:
     """Time [s], the control-period counter, rigid-body state, the event record, the squared pendulum
     rate of the body swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the
-    descent step, the turbulence filters (None without turbulence) and the closed loop's state (None
-    without a controller).
+    descent step, the turbulence filters (None without turbulence), the closed loop's state (None
+    without a controller) and the avionics' (None without sensors).
 
     tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A long period of
     steady descent (``steady_descent``: up to ``settings.descent_dt_s``, the GNC idle) counts one too, so
@@ -102,6 +104,7 @@ class FlightState:
     canopy_stiffness: jnp.ndarray
     turbulence: TurbulenceState | None
     gnc: GncState | None = None
+    avionics: AvionicsState | None = None
 
 
 class Diagnostics(NamedTuple):
@@ -278,8 +281,9 @@ def initial_state(p: FlightParams) -> FlightState:
     )  # fmt: skip
     turbulence = p.environment.turbulence
     filters = None if turbulence is None else initial_turbulence(turbulence)
-    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero)
-    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters, gnc)
+    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero, p.launch.q_nb0)
+    avionics = None if p.avionics is None else initial_avionics(p.avionics, zero)
+    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters, gnc, avionics)
 
 
 def done(state: FlightState):
@@ -313,11 +317,14 @@ def control_period(p: FlightParams, settings: SimSettings, state: FlightState):
 
 
 def control_step(
-    p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None
-) -> FlightState:
+    p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None,
+    first_stage: bool = False,
+) -> tuple[FlightState, tuple | None]:  # fmt: skip
     """One control period of ``period`` [s] (``control_period``) with the turbulent gust held: RK4 substeps
     of the rigid body with events, then the turbulence filters advanced over the period with ``noise``,
-    the period's row of ``block_noise`` (None without turbulence); ``tick`` + 1.
+    the period's row of turbulence noise (None without turbulence); ``tick`` + 1. Returns the new state and,
+    with ``first_stage``, the state derivative and the dynamic pressure [Pa] at the period start (the first RK4
+    stage's), else None.
 
     deflections: the canard deflections δ1..δn [rad] as a function of the time t [s] inside the
     period (held, or the servos' response evaluated at each RK4 stage).
@@ -331,16 +338,20 @@ def control_step(
         scales = turbulence_scales(turbulence, altitude)
         gust = gust_n(state.turbulence, scales, mean_wind_n, state.body.q_nb)
 
+    def rhs(t, y, events):
+        d_body, diag = derivatives(t, y, p, deflections(t), gust, events)
+        return d_body, (diag, (d_body, diag.qbar) if first_stage else None)
+
     def substep(carry, _):
         t0, body0, events, _ = carry
-        rhs = lambda t, y: derivatives(t, y, p, deflections(t), gust, events)  # noqa: E731
-        body1, diag = rk4_step(rhs, t0, body0, h)
+        body1, (diag, derivative) = rk4_step(lambda t, y: rhs(t, y, events), t0, body0, h)
         body1 = normalize_attitude(body1)
         events = update_events(p, start_n, events, t0, h, body0, body1, diag)
-        return (t0 + h, body1, events, diag.canopy_stiffness), None
+        return (t0 + h, body1, events, diag.canopy_stiffness), derivative
 
     carry = (state.t, state.body, state.events, state.canopy_stiffness)
-    (t, body, events, stiffness), _ = jax.lax.scan(substep, carry, None, settings.substeps)
+    (t, body, events, stiffness), derivatives_at_start = jax.lax.scan(substep, carry, None, settings.substeps)
+    first = None if derivatives_at_start is None else jax.tree_util.tree_map(lambda x: x[0], derivatives_at_start)
     finite = functools.reduce(jnp.logical_and, [jnp.isfinite(x) for x in jax.tree_util.tree_leaves(body)])
     body = tree_where(done(state) | ~finite, state.body, body)
     events = tree_where(done(state), state.events, events)
@@ -349,29 +360,89 @@ def control_step(
     if turbulence is not None:
         airspeed = (state.body.v_n - mean_wind_n - gust).norm()
         filters = advance_turbulence(filters, scales, airspeed, period, noise)
-    return FlightState(state.t + period, state.tick + 1, body, events, stiffness, filters, state.gnc)
+    return FlightState(state.t + period, state.tick + 1, body, events, stiffness, filters, state.gnc, state.avionics), first
 
 
-def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, noise, canard_command=None):
-    """The step of every driver (``fly_block``, ``fly``): the canard deflections of the period, then
-    ``control_step``. start_n: ``rail_start_n(p)``; canard_command: open-loop deflections, a function
-    of time [s] returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when
-    ``p.gnc`` is set: guidance and control at the period start, the servos' response inside it)."""
+class StepNoise(NamedTuple):
+    """A control period's random numbers: the turbulence's row (None without turbulence) and each sensor's
+    (``sensors.avionics.avionics_noise``; None without sensors)."""
+
+    turbulence: jnp.ndarray | None
+    avionics: dict | None
+
+
+def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, noise: StepNoise,
+         canard_command=None):  # fmt: skip
+    """The step of every driver (``fly_block``, ``fly``): the sensors at the period start, the canard
+    deflections of the period, ``control_step``, then the accelerometer. start_n: ``rail_start_n(p)``;
+    noise: the period's ``StepNoise``; canard_command: open-loop deflections, a function of time [s]
+    returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when ``p.gnc`` is set:
+    guidance and control at the period start, the servos' response inside it)."""
     period = control_period(p, settings, state)
+    sensing = period <= settings.control_dt_s  # the sensors sample in GNC periods only, not in long descent ones
     if p.gnc is None:
         held = jnp.zeros(p.rocket.aero.n_canards) if canard_command is None else canard_command(state.t)
         held = jnp.asarray(held, dtype=float)
-        return control_step(p, settings, start_n, state, period, lambda t: held, noise)
+        start = _sensed(p, state, held, sensing, noise)
+        state, first = control_step(p, settings, start_n, start, period, lambda t: held, noise.turbulence,
+                                    p.avionics is not None)  # fmt: skip
+        return _accelerometer(p, start, state, first, sensing, noise)
     if canard_command is not None:
         raise ValueError("canard_command flies open loop: it needs a flight without a controller (p.gnc None)")
     servo_params, t0 = p.gnc.servo, state.t
+    state = start = _sensed(p, state, state.gnc.servo.deflection_rad, sensing, noise)
     canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in state.events.chute_trigger_times], False)
-    altitude_msl = p.environment.site_altitude_m - state.body.r_n.z
-    gnc = gnc_step(p.gnc, state.gnc, truth(state.body), t0, settings.control_dt_s, altitude_msl, canopy)
+    if p.gnc.navigation == "sensors":
+        bus = state.avionics.bus
+        nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
+        moving = liftoff_sensed(p.avionics, bus)
+        state = dataclasses.replace(state, gnc=dataclasses.replace(state.gnc, navigation=navigation))
+    else:
+        nav, moving = truth(state.body)
+    altitude_msl = p.environment.site_altitude_m - nav.r_n.z
+    gnc = gnc_step(p.gnc, state.gnc, nav, moving, t0, settings.control_dt_s, altitude_msl, canopy)
     servo = end_of_period(servo_params, gnc.servo, period)
-    state = control_step(p, settings, start_n, state, period, lambda t: deflection_at(servo_params, gnc.servo, t - t0),
-                         noise)  # fmt: skip
-    return dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
+    state, first = control_step(p, settings, start_n, state, period,
+                                lambda t: deflection_at(servo_params, gnc.servo, t - t0), noise.turbulence,
+                                p.avionics is not None)  # fmt: skip
+    state = dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
+    return _accelerometer(p, start, state, first, sensing, noise)
+
+
+def _at_rest_once_landed(state: FlightState) -> RigidBodyState:
+    """The body the sensors see: once landed (or stopped) at rest where it came down."""
+    body, landed = state.body, done(state)
+    zero = Vec3.zeros(state.t)
+    return body._replace(v_n=tree_where(landed, zero, body.v_n), omega_b=tree_where(landed, zero, body.omega_b))
+
+
+def _sensed(p: FlightParams, state: FlightState, deflections, sensing, noise: StepNoise) -> FlightState:
+    """``state`` with every sensor but the accelerometer sampled at its time (no change without sensors)."""
+    if p.avionics is None:
+        return state
+    body = _at_rest_once_landed(state)
+    avionics = sense(p.avionics, state.avionics, state.tick, state.t, body.r_n, body.v_n, body.q_nb, body.omega_b,
+                     deflections, p.environment.site_altitude_m, sensing, noise.avionics)  # fmt: skip
+    return dataclasses.replace(state, avionics=avionics)
+
+
+def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, first: tuple | None, sensing,
+                   noise: StepNoise) -> FlightState:  # fmt: skip
+    """``state``, the period's end, with the accelerometer's sample of the period start ``start`` (from the
+    state derivative and dynamic pressure ``first`` there, at rest once landed); ``state`` itself without
+    sensors."""
+    if p.avionics is None:
+        return state
+    first, qbar = first
+    body, landed = _at_rest_once_landed(start), done(start)
+    zero = Vec3.zeros(start.t)
+    position = p.avionics.accelerometer.position_b
+    arm_b = Vec3(position[0] - mass_properties(p, start.t).cg_x, position[1], position[2])
+    force = specific_force_b(tree_where(landed, zero, first.v_n), body.q_nb, body.omega_b,
+                             tree_where(landed, zero, first.omega_b), arm_b)  # fmt: skip
+    qbar = jnp.where(landed, 0.0, qbar)
+    avionics = sense_acceleration(p.avionics, state.avionics, start.tick, force, qbar, sensing, noise.avionics)
+    return dataclasses.replace(state, avionics=avionics)
 
 
 def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
@@ -403,36 +474,39 @@ def fly_block(p: FlightParams, settings: SimSettings, state: FlightState, index)
     return jax.lax.scan(lambda s, n: (step(p, settings, start_n, s, n), None), state, noise, settings.block_steps)[0]
 
 
-def block_noise(p: FlightParams, index, n_periods: int):
-    """The turbulence's white noise for block ``index`` of ``n_periods`` control periods,
-    (n_periods, 10), or None without turbulence. Blocks are ``settings.block_steps`` long in
-    ``fly_block`` and ``fly`` alike, so both fly the same gusts."""
+def block_noise(p: FlightParams, index, n_periods: int) -> StepNoise:
+    """The random numbers of block ``index`` of ``n_periods`` control periods, each with a leading axis
+    ``n_periods``: the turbulence's white noise (n_periods, 10) and each sensor's (None without them). Blocks
+    are ``settings.block_steps`` long in ``fly_block`` and ``fly`` alike, so both fly the same gusts and
+    sensor errors."""
     turbulence = p.environment.turbulence
-    return None if turbulence is None else turbulence_noise(turbulence, index, n_periods)
+    return StepNoise(None if turbulence is None else turbulence_noise(turbulence, index, n_periods),
+                     None if p.avionics is None else avionics_noise(p.avionics, index, n_periods))  # fmt: skip
 
 
-def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=None):
+def fly(p: FlightParams, settings: SimSettings, n_periods: int, canard_command=None, record=None):
     """Fly ``n_periods`` control periods and return (final state, trajectory): the trajectory is the
     ``FlightState`` after each period, stacked along a leading axis (``trajectory.t`` holds the
     times, since periods grow in steady descent).
 
     canard_command: open-loop deflections, a function of time [s] returning δ1..δn [rad] held over
-    each control period (default: neutral).
+    each control period (default: neutral); record: what the trajectory keeps of each period's state, a
+    function of the ``FlightState`` returning a pytree (default: all of it).
     """
     start_n = rail_start_n(p)
 
     def period(s, noise):
         s = step(p, settings, start_n, s, noise, canard_command)
-        return s, s
+        return s, s if record is None else record(s)
 
     def block(s, index, length):  # the first ``length`` periods of block ``index``
-        noise = block_noise(p, index, settings.block_steps)
-        return jax.lax.scan(period, s, None if noise is None else noise[:length], length)
+        noise = jax.tree_util.tree_map(lambda x: x[:length], block_noise(p, index, settings.block_steps))
+        return jax.lax.scan(period, s, noise, length)
 
     full, rest = divmod(n_periods, settings.block_steps)
     blocks = jnp.arange(full, dtype=jnp.uint32)
     state, trajectory = jax.lax.scan(lambda s, i: block(s, i, settings.block_steps), initial_state(p), blocks)
-    trajectory = jax.tree_util.tree_map(lambda x: x.reshape(-1, *x.shape[2:]), trajectory)
+    trajectory = jax.tree_util.tree_map(lambda x: x.reshape(x.shape[0] * x.shape[1], *x.shape[2:]), trajectory)
     if rest:
         state, tail = block(state, jnp.uint32(full), rest)
         trajectory = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a, b]), trajectory, tail)

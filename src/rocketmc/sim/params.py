@@ -9,6 +9,7 @@ import jax.numpy as jnp
 from ..aero import LinearAero
 from ..dynamics import Motor, Parachute
 from ..gnc.control import GncParams
+from ..sensors.avionics import Avionics
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass
@@ -68,12 +69,13 @@ class Environment:
 @pytree_dataclass
 class FlightParams:
     """Everything one realization needs (all leaves dynamic: they can be dispersed); gnc: the closed
-    loop (None: canards neutral, and no cost)."""
+    loop (None: canards neutral, and no cost); avionics: the sensors (None: none simulated, and no cost)."""
 
     rocket: Rocket
     launch: Launch
     environment: Environment
     gnc: GncParams | None = None
+    avionics: Avionics | None = None
 
 
 @dataclasses.dataclass(frozen=True)

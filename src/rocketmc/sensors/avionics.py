@@ -1,0 +1,211 @@
+"""The avionics: the rocket's sensors sampled at the GNC ticks, and the bus they write.
+
+Each sensor turns the truth at the tick t_k into its measurement (``errors.sample``) and writes its
+latest sample on the ``Bus``, the one thing navigation and control read. The accelerometer needs the
+acceleration at t_k, a by-product of the period's first RK4 stage: it is sampled after the period's
+integration (``sense_acceleration``) and so reaches the bus one tick after the others, as the input a
+filter propagates with from t_k to t_{k+1}. Noise comes a block of ticks at a time from one stream per
+sensor (``avionics_noise``), so that adding a sensor leaves every other draw unchanged.
+
+Frames: NED from the pad, FRD body, each sensor's own axes (``rotation``: body → sensor, known to the
+avionics). SI inside: m/s², rad/s, tesla, Pa, rad.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from ..env.atmosphere import G0, isa
+from ..math import Quat, Vec3
+from ..pytree import pytree_dataclass
+from .errors import Channel, ChannelState, initial_channel, sample
+from .parts import SENSORS
+
+
+@pytree_dataclass
+class Reading:
+    """A sensor's latest delivered sample on the bus: value (n,) in its unit and frame; fresh: delivered at
+    this tick; valid: some sample has been delivered."""
+
+    value: jnp.ndarray
+    fresh: jnp.ndarray
+    valid: jnp.ndarray
+
+
+@pytree_dataclass
+class Bus:
+    """Every sensor's latest sample. accelerometer: specific force [m/s²], sensor frame, sampled at the
+    previous tick; gyroscope: body rates [rad/s], sensor frame; magnetometer: field [T], sensor frame;
+    barometer: (1,) static pressure [Pa]; gnss: (6,) position [m] and velocity [m/s], NED from the pad;
+    canard_feedback: (4,) servo positions δ1..δ4 [rad]."""
+
+    accelerometer: Reading
+    gyroscope: Reading
+    magnetometer: Reading
+    barometer: Reading
+    gnss: Reading
+    canard_feedback: Reading
+
+
+@pytree_dataclass
+class Mounted:
+    """A 3-axis sensor on the airframe: its channel, rotation (3, 3) from body to sensor axes (the mounting,
+    known to the avionics) and position_b (3,), where it sits in the body frame [m]."""
+
+    channel: Channel
+    rotation: jnp.ndarray
+    position_b: jnp.ndarray
+
+
+@pytree_dataclass
+class Magnetometer:
+    """A magnetometer (``Mounted``) in the site's geomagnetic field field_n (3,) [T, NED], behind the
+    airframe's soft iron (3, 3) and hard iron (3,) [T, sensor frame]."""
+
+    sensor: Mounted
+    field_n: jnp.ndarray
+    soft_iron: jnp.ndarray
+    hard_iron: jnp.ndarray
+
+
+@pytree_dataclass
+class Gnss:
+    """A GNSS receiver: its channel (6 axes: position [m], velocity [m/s], NED), the sinusoidal position bias
+    amplitude (3,) [m] · sin(2π·frequency [Hz]·t + phase (3,) [rad]), and the time of its first fix [s]."""
+
+    channel: Channel
+    amplitude: jnp.ndarray
+    frequency: jnp.ndarray
+    phase: jnp.ndarray
+    first_fix_s: jnp.ndarray
+
+
+@pytree_dataclass
+class Avionics:
+    """The sensors of one flight and the keys of their noise streams (by sensor name); canard_feedback is None
+    on a rocket without canards."""
+
+    accelerometer: Mounted
+    gyroscope: Mounted
+    magnetometer: Magnetometer
+    barometer: Channel
+    gnss: Gnss
+    canard_feedback: Channel | None
+    keys: dict
+
+
+@pytree_dataclass
+class AvionicsState:
+    """Each sensor's error state (``errors.ChannelState``, by name), the bus, and the dynamic pressure at the
+    last accelerometer sample [Pa] (the vibration of the sensors sampled at the next tick)."""
+
+    channels: dict
+    bus: Bus
+    qbar: jnp.ndarray
+
+
+def channels(av: Avionics) -> dict[str, Channel]:
+    """Each sensor's ``Channel``, by name in the bus's order (none for an absent canard feedback)."""
+    every = {"accelerometer": av.accelerometer.channel, "gyroscope": av.gyroscope.channel,
+             "magnetometer": av.magnetometer.sensor.channel, "barometer": av.barometer, "gnss": av.gnss.channel,
+             "canard_feedback": av.canard_feedback}  # fmt: skip
+    return {name: c for name, c in every.items() if c is not None}
+
+
+def initial_avionics(av: Avionics, like) -> AvionicsState:
+    """Nothing sampled yet (an absent sensor's reading empty for good); ``like``: a scalar of the flight's dtype."""
+    present = channels(av)
+    state = {name: initial_channel(c, like) for name, c in present.items()}
+    no = jnp.zeros((), bool)
+    sizes = [present[name].n if name in present else 0 for name in SENSORS]
+    bus = Bus(*(Reading(jnp.zeros(n, jnp.result_type(like)), no, no) for n in sizes))
+    return AvionicsState(state, bus, jnp.zeros_like(like))
+
+
+def noise_columns(av: Avionics) -> dict[str, slice]:
+    """Each sensor's columns in ``avionics_noise``'s rows, by name (sensors that draw nothing left out)."""
+    columns, start = {}, 0
+    for name, c in channels(av).items():
+        if c.noise_per_tick:
+            columns[name], start = slice(start, start + c.noise_per_tick), start + c.noise_per_tick
+    return columns
+
+
+def avionics_noise(av: Avionics, block, n_ticks: int):
+    """The sensors' standard normals for block ``block`` of ``n_ticks`` ticks, (n_ticks, k), each sensor's
+    columns (``noise_columns``) drawn in float32 from its own stream like the turbulence's; None if no sensor
+    draws any. A sensor sampled every m ticks draws for its samples only (each row repeated m times; blocks
+    start at multiples of m: the campaign checks that m divides their length). One array, not one per sensor: the flight loop slices each of
+    its inputs per tick (a kernel each), and six of them cost 8 % of a flight (measured)."""
+    present = channels(av)
+    draws = []
+    for name, s in noise_columns(av).items():
+        every = present[name].every
+        key = jax.random.fold_in(av.keys[name], block + 1)
+        draw = jax.random.normal(key, (-(-n_ticks // every), s.stop - s.start), jnp.float32)
+        draws.append(jnp.repeat(draw, every, axis=0)[:n_ticks])
+    return jnp.concatenate(draws, axis=1).astype(jnp.result_type(float)) if draws else None
+
+
+
+def _apply(matrix, v: Vec3):
+    """``matrix`` (3, 3) times ``v``, as a (3,) array (written out: no small matrix product under vmap)."""
+    return jnp.stack([matrix[i, 0] * v.x + matrix[i, 1] * v.y + matrix[i, 2] * v.z for i in range(3)])
+
+
+def _read(av: Avionics, av_channel: Channel, state: AvionicsState, name: str, tick, truth, noise, enabled, qbar=0.0):
+    """(the new Reading, the new ChannelState) of sensor ``name`` at ``tick``; noise: the tick's row of
+    ``avionics_noise``; qbar: the dynamic pressure [Pa] (vibration)."""
+    columns = noise_columns(av)
+    own = noise[columns[name]] if name in columns else None
+    value, fresh, channel_state = sample(av_channel, state.channels[name], tick, truth, own, enabled, qbar)
+    old = getattr(state.bus, name)
+    return Reading(jnp.where(fresh, value, old.value), fresh, old.valid | fresh), channel_state
+
+
+def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_nb: Quat, omega_b: Vec3,
+          deflections, site_altitude_m, enabled, noise) -> AvionicsState:  # fmt: skip
+    """Every sensor but the accelerometer at tick ``tick``, time t [s], from the truth: position r_n [m] and
+    velocity v_n [m/s] of the CG (NED), attitude q_nb, body rates omega_b [rad/s], the servos' deflections
+    (n_canards,) [rad]; enabled: the sensors sample (False in the long descent periods); noise: this tick's row of
+    ``avionics_noise``."""
+    mag = av.magnetometer
+    field_s = _apply(mag.sensor.rotation, q_nb.rotate_inverse(Vec3(*(mag.field_n[i] for i in range(3)))))
+    gnss, fix = av.gnss, jnp.concatenate([r_n.to_array(), v_n.to_array()])
+    if not gnss.channel.ideal:  # the slow sinusoidal position bias and its derivative, an error of the receiver
+        phase = 2.0 * jnp.pi * gnss.frequency * t + gnss.phase
+        omega = 2.0 * jnp.pi * gnss.frequency
+        fix = fix + jnp.concatenate([gnss.amplitude * jnp.sin(phase), gnss.amplitude * omega * jnp.cos(phase)])
+    truths = {
+        "gyroscope": (av.gyroscope.channel, _apply(av.gyroscope.rotation, omega_b)),
+        "magnetometer": (mag.sensor.channel, _apply(mag.soft_iron, Vec3(*field_s)) + mag.hard_iron),
+        "barometer": (av.barometer, isa(site_altitude_m - r_n.z).pressure[None]),
+        "gnss": (gnss.channel, fix),
+        "canard_feedback": (av.canard_feedback, deflections),
+    }  # fmt: skip
+    readings, channel_states = {"canard_feedback": state.bus.canard_feedback}, dict(state.channels)
+    for name, (channel, truth) in truths.items():
+        if channel is None:
+            continue
+        gate = enabled & (t >= gnss.first_fix_s) if name == "gnss" else enabled
+        readings[name], channel_states[name] = _read(av, channel, state, name, tick, truth, noise, gate, state.qbar)
+    bus = Bus(state.bus.accelerometer, **readings)
+    return AvionicsState(channel_states, bus, state.qbar)
+
+
+def specific_force_b(acceleration_n: Vec3, q_nb: Quat, omega_b: Vec3, omega_dot_b: Vec3, arm_b: Vec3) -> Vec3:
+    """Specific force [m/s², body frame] at ``arm_b`` [m] from the CG: A(q)(a − g) + ω̇×r + ω×(ω×r), with the
+    CG's acceleration a [m/s², NED] and g = (0, 0, G0)."""
+    at_cg = q_nb.rotate_inverse(acceleration_n - Vec3(0.0, 0.0, G0))
+    return at_cg + omega_dot_b.cross(arm_b) + omega_b.cross(omega_b.cross(arm_b))
+
+
+def sense_acceleration(av: Avionics, state: AvionicsState, tick, specific_force: Vec3, qbar, enabled, noise) -> AvionicsState:
+    """The accelerometer's sample of tick ``tick`` from the specific force at its position [m/s², body frame] and
+    the dynamic pressure [Pa] then (the airframe's vibration)."""
+    accel = av.accelerometer
+    reading, channel_state = _read(av, accel.channel, state, "accelerometer", tick,
+                                   _apply(accel.rotation, specific_force), noise, enabled, qbar)  # fmt: skip
+    bus = Bus(reading, *(getattr(state.bus, name) for name in SENSORS[1:]))
+    return AvionicsState({**state.channels, "accelerometer": channel_state}, bus, qbar)
