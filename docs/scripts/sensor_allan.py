@@ -40,12 +40,17 @@ def main(seconds: float = 7200.0) -> None:
         for sensor, (prefix, unit, scale) in CHANNELS.items():
             config = getattr(campaign.config.avionics, sensor)
             n_set, k_set = configured(config)
+            variances = []
             for axis in "xyz":
                 column = f"{prefix}_{axis}_{'mps2' if prefix == 'acc' else 'radps'}"
                 taus, adev = allan_deviation(imu[column].to_numpy() * scale, config.rate_hz)
                 fit = noise_terms(taus, adev)
                 series[f"{part} {sensor} {axis} [{unit}]"] = (taus, adev)
+                variances.append(adev**2)
                 rows.append((part, sensor, axis, unit, n_set, fit["N"], fit["white_slope"], k_set, fit["K"], fit["walk_slope"]))
+            # the three axes share N and K: their mean Allan variance has three times the degrees of freedom
+            fit = noise_terms(taus, np.sqrt(np.mean(variances, axis=0)))
+            rows.append((part, sensor, "mean", unit, n_set, fit["N"], fit["white_slope"], k_set, fit["K"], fit["walk_slope"]))
     print(f"{'part':<8}{'sensor':<15}{'axis':<5}{'unit':<7}{'N set':>11}{'N fit':>11}{'ratio':>7}{'slope':>7}"
           f"{'K set':>11}{'K fit':>11}{'ratio':>7}{'slope':>7}")
     for part, sensor, axis, unit, n_set, n_fit, white_slope, k_set, k_fit, walk_slope in rows:

@@ -279,10 +279,8 @@ def _sensors_simulate(args) -> int:
     from .campaign.sensor_record import sensor_record
 
     campaign = _campaign(args.campaign)
-    what = f"{args.static:g} s at rest on the pad" if args.static else "its flight"
-    if not args.quiet:
-        print(f"{campaign.config.name}: realization {args.realization}, {what} (compiling, then flying)", file=sys.stderr)
-    logs = sensor_record(campaign, args.realization, args.static)
+    logs = sensor_record(campaign, args.realization, args.static,
+                         log=lambda line: None if args.quiet else print(line, file=sys.stderr))  # fmt: skip
     write_sensor_log(args.out, logs)
     for name, frame in logs.items():
         print(f"wrote {Path(args.out) / LOG_FILES[name][0]}: {len(frame)} samples", file=sys.stderr)

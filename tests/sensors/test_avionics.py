@@ -128,3 +128,21 @@ def test_a_static_record_has_the_configured_white_noise_level():
         fit = noise_terms(*allan_deviation(imu[column].to_numpy(), 50.0))
         assert fit["N"] == pytest.approx(noise_std / math.sqrt(50.0), rel=0.1), column
         assert fit["white_slope"] == pytest.approx(-0.5, abs=0.05), column
+
+
+def test_sensors_simulate_writes_the_real_logs_files_or_refuses_in_one_line(tmp_path, capsys):
+    from rocketmc.analysis.sensor_log import LOG_FILES
+    from rocketmc.cli import main
+
+    out = tmp_path / "log"
+    assert main(["sensors", "simulate", str(CAMPAIGNS / "lynx_nominal.toml"), "--out", str(out)]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 1 and "avionics: the campaign has no [avionics] section" in lines[0], lines
+    assert not out.exists()
+    campaign = tmp_path / "with_sensors.toml"
+    campaign.write_text((CAMPAIGNS / "lynx_nominal.toml").read_text() + '\n[avionics]\npart = "bmx160"\n')
+    assert main(["sensors", "simulate", str(campaign), "--static", "1", "--out", str(out), "--quiet"]) == 0
+    # the real log's files and columns; a second at 50 Hz, no GNSS fix yet (the thesis's first comes at 10 s)
+    for stream, (file, header) in LOG_FILES.items():
+        lines = (out / file).read_text().splitlines()
+        assert lines[0] == ",".join(header) and len(lines) == 1 + {"gnss": 0}.get(stream, 50), file

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 import jax
 import jax.numpy as jnp
@@ -28,17 +29,20 @@ MICROTESLA = 1e6
 """The log's magnetometer unit per tesla."""
 
 
-def sensor_record(campaign: Campaign, realization: int = 0, static_s: float | None = None) -> dict[str, pd.DataFrame]:
+def sensor_record(campaign: Campaign, realization: int = 0, static_s: float | None = None,
+                  log: Callable[[str], None] = lambda line: None) -> dict[str, pd.DataFrame]:  # fmt: skip
     """The sensor log of realization ``realization`` (its drawn errors and gusts), by stream name ("imu", "baro",
     "gnss"), each a DataFrame of the time ``t_s`` [s] and the real log's value columns (``analysis.sensor_log.LOG_FILES``); ``static_s``:
-    instead the rocket at rest on the pad for that long [s]. ConfigError without an [avionics] section or for
-    a realization outside the campaign."""
+    instead the rocket at rest on the pad for that long [s]; ``log`` receives a progress line once the request
+    is checked. ConfigError without an [avionics] section or for a realization outside the campaign."""
     config = campaign.config
     if config.avionics is None:
         raise ConfigError('avionics: the campaign has no [avionics] section, no sensors to simulate (add one, e.g. '
                           '[avionics] part = "thesis")')  # fmt: skip
     if not 0 <= realization < config.n_realizations:
         raise ConfigError(f"--realization: {realization} is not a realization of the campaign (0 to {config.n_realizations - 1})")
+    what = "its flight" if static_s is None else f"{static_s:g} s at rest on the pad"
+    log(f"{config.name}: realization {realization}, {what} (compiling, then flying)")
     dt = config.simulation.control_dt_s
     settings = dataclasses.replace(sim_settings(campaign), descent_dt_s=dt)
     params, _ = realization_params(campaign, jax.random.key(config.seed), np.uint32(realization))
