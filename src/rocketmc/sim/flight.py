@@ -319,12 +319,12 @@ def control_period(p: FlightParams, settings: SimSettings, state: FlightState):
 def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None,
     first_stage: bool = False,
-) -> tuple[FlightState, tuple | None]:  # fmt: skip
+) -> tuple[FlightState, jnp.ndarray | None]:  # fmt: skip
     """One control period of ``period`` [s] (``control_period``) with the turbulent gust held: RK4 substeps
     of the rigid body with events, then the turbulence filters advanced over the period with ``noise``,
     the period's row of turbulence noise (None without turbulence); ``tick`` + 1. Returns the new state and,
-    with ``first_stage``, the state derivative and the dynamic pressure [Pa] at the period start (the first RK4
-    stage's), else None.
+    with ``first_stage``, the CG's acceleration [m/s², NED], the body's angular acceleration [rad/s², FRD] and
+    the dynamic pressure [Pa] at the period start (the first RK4 stage's), as one (7,) array, else None.
 
     deflections: the canard deflections δ1..δn [rad] as a function of the time t [s] inside the
     period (held, or the servos' response evaluated at each RK4 stage).
@@ -340,7 +340,9 @@ def control_step(
 
     def rhs(t, y, events):
         d_body, diag = derivatives(t, y, p, deflections(t), gust, events)
-        return d_body, (diag, (d_body, diag.qbar) if first_stage else None)
+        # one array, not a pytree: RK4 keeps its first stage's by-products with a select per leaf and stage
+        extra = jnp.stack([*d_body.v_n, *d_body.omega_b, diag.qbar]) if first_stage else None
+        return d_body, (diag, extra)
 
     def substep(carry, _):
         t0, body0, events, _ = carry
@@ -426,20 +428,20 @@ def _sensed(p: FlightParams, state: FlightState, deflections, sensing, noise: St
     return dataclasses.replace(state, avionics=avionics)
 
 
-def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, first: tuple | None, sensing,
+def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, first, sensing,
                    noise: StepNoise) -> FlightState:  # fmt: skip
     """``state``, the period's end, with the accelerometer's sample of the period start ``start`` (from the
-    state derivative and dynamic pressure ``first`` there, at rest once landed); ``state`` itself without
-    sensors."""
+    accelerations and dynamic pressure ``first`` there, ``control_step``'s, at rest once landed); ``state`` itself
+    without sensors."""
     if p.avionics is None:
         return state
-    first, qbar = first
+    acceleration_n, omega_dot_b, qbar = Vec3(*first[:3]), Vec3(*first[3:6]), first[6]
     body, landed = _at_rest_once_landed(start), done(start)
     zero = Vec3.zeros(start.t)
     position = p.avionics.accelerometer.position_b
     arm_b = Vec3(position[0] - mass_properties(p, start.t).cg_x, position[1], position[2])
-    force = specific_force_b(tree_where(landed, zero, first.v_n), body.q_nb, body.omega_b,
-                             tree_where(landed, zero, first.omega_b), arm_b)  # fmt: skip
+    force = specific_force_b(tree_where(landed, zero, acceleration_n), body.q_nb, body.omega_b,
+                             tree_where(landed, zero, omega_dot_b), arm_b)  # fmt: skip
     qbar = jnp.where(landed, 0.0, qbar)
     avionics = sense_acceleration(p.avionics, state.avionics, start.tick, force, qbar, sensing, noise.avionics)
     return dataclasses.replace(state, avionics=avionics)
