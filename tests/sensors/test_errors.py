@@ -103,3 +103,14 @@ def test_sample_is_jit_and_vmap_bitwise():
         single = jax.jit(one)(truths[i], noises[i])
         for a, b in zip(jax.tree_util.tree_leaves(single), jax.tree_util.tree_leaves(batched)):
             np.testing.assert_array_equal(a, b[i])
+
+
+def test_vibration_adds_its_variance_to_the_sensors_white_noise():
+    # σ² = σ_0² + (v·q̄)²: 0.3 and 0.4 make 0.5 (a 3-4-5 triangle, exact in floating point) on the same normals
+    c = channel(noise_std=jnp.asarray(0.3), walk_std=None, lsb=jnp.asarray(0.0), vibration=jnp.full(3, 0.004))
+    noise = jnp.array([1.0, -2.0, 0.5])
+    y, _ = corrupt(c, jnp.zeros(3), jnp.zeros(3), noise, qbar=100.0)
+    np.testing.assert_allclose(y, 0.5 * noise, rtol=1e-15)
+    assert c.noise_per_tick == 3  # one normal per axis: the vibration draws none of its own
+    y, _ = corrupt(c, jnp.zeros(3), jnp.zeros(3), noise, qbar=0.0)  # on the ground: the sensor's own noise
+    np.testing.assert_allclose(y, 0.3 * noise, rtol=1e-15)

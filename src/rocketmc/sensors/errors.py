@@ -7,7 +7,8 @@ of its samples, in its own unit (SI) and frame:
 
 x the truth, G the gain matrix (scale factor, cross-axis coupling and misalignment: unknown to the
 avionics), b the constant bias (drawn per flight), β the bias instability as a random walk, σ the white
-noise per sample, S saturation at the range, Q quantisation to the LSB (round half away from zero).
+noise per sample (the sensor's and the airframe's vibration, σ² = σ_0² + (v·q̄)²), S saturation at the
+range, Q quantisation to the LSB (round half away from zero).
 The channel samples every ``every`` GNC ticks (sample-and-hold between) and delivers each sample
 ``delay`` ticks later. ``docs/sensors.md`` gives each sensor's model and sources.
 
@@ -51,9 +52,9 @@ class Channel:
     gain: G (n, n), None for the identity; bias: b (n,); noise_std: σ per sample (scalar or (n,)), None for
     no white noise; walk_std: σ_β, the random walk's step per sample, None for no walk (None: nothing drawn for
     it, where a campaign's value is 0 and not dispersed); low, high: the range; lsb: the quantisation step
-    (0: none). every: the sample
-    period in GNC ticks; delay: the latency in ticks (both static); ideal: errors off (the truth at each
-    sample, on the same schedule; static)."""
+    (0: none); vibration: the airframe's, more white noise per sample per pascal of dynamic pressure (n,)
+    [unit/Pa], its variance added to σ² (None: none). every: the sample period in GNC ticks; delay: the
+    latency in ticks (both static); ideal: errors off (the truth at each sample, on the same schedule; static)."""
 
     gain: jnp.ndarray | None
     bias: jnp.ndarray
