@@ -282,7 +282,7 @@ def _sensors_simulate(args) -> int:
     logs = sensor_record(campaign, args.realization, args.static,
                          log=lambda line: None if args.quiet else print(line, file=sys.stderr))  # fmt: skip
     write_sensor_log(args.out, logs)
-    for name, frame in logs.items():
+    for name, frame in logs.items() if not args.quiet else ():
         print(f"wrote {Path(args.out) / LOG_FILES[name][0]}: {len(frame)} samples", file=sys.stderr)
     return 0
 

@@ -142,6 +142,7 @@ def test_sensors_simulate_writes_the_real_logs_files_or_refuses_in_one_line(tmp_
     campaign = tmp_path / "with_sensors.toml"
     campaign.write_text((CAMPAIGNS / "lynx_nominal.toml").read_text() + '\n[avionics]\npart = "bmx160"\n')
     assert main(["sensors", "simulate", str(campaign), "--static", "1", "--out", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""  # --quiet: errors only
     # the real log's files and columns; a second at 50 Hz, no GNSS fix yet (the thesis's first comes at 10 s)
     for stream, (file, header) in LOG_FILES.items():
         lines = (out / file).read_text().splitlines()

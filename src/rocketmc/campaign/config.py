@@ -818,8 +818,7 @@ class Campaign:
         if sensors is not None and data["gnc"] is not None:
             data["gnc"]["navigation"] = "sensors" if sensors else "truth"
         config = _validate(data)
-        _check_avionics(config)
-        config = config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
+        config = _with_sensor_spreads(config)
         campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
         new_aero = config.rocket.aero.model != self.config.rocket.aero.model
         if new_aero:
@@ -1008,8 +1007,7 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
             raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
                               f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
 
-    _check_avionics(config)
-    config = config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
+    config = _with_sensor_spreads(config)
     nominal = _nominal_values(config)
     _check_dispersions(config, nominal)
     aero = _aero_model(config.rocket, base_dir)
@@ -1048,6 +1046,13 @@ def _check_avionics(config: CampaignConfig) -> None:
     for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
         sample_period_ticks(config, sensor)
         sensor_ticks(config, getattr(config.avionics, sensor).latency_s, f"avionics.{sensor}.latency_s")
+
+
+def _with_sensor_spreads(config: CampaignConfig) -> CampaignConfig:
+    """``config`` checked (``_check_avionics``) with its sensors' spreads among its dispersions, the file's own
+    dispersions kept where both name a value."""
+    _check_avionics(config)
+    return config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
 
 
 def sensor_spreads(config: CampaignConfig) -> dict[str, Dispersion]:

@@ -17,12 +17,11 @@ import jax.numpy as jnp
 import numpy as np
 import pandas as pd
 
+from ..env.site import latitude_longitude_deg
 from ..sim.flight import fly
 from .config import Campaign, ConfigError
 from .runner import realization_params, sim_settings
 
-EARTH_RADIUS_M = 6_371_008.8
-"""The mean Earth radius [m] (IUGG), turning the flat-Earth NED offsets of a GNSS fix into latitude and longitude."""
 AFTER_LANDING_S = 20.0
 """How long a flight's log goes on after impact [s]: the real log has ~19 s at rest on the ground."""
 MICROTESLA = 1e6
@@ -72,7 +71,7 @@ def _frames(bus, t, keep, site) -> dict[str, pd.DataFrame]:
     baro = rows(bus.barometer)
     fix = rows(bus.gnss)
     r, v = bus.gnss.value[fix, :3], bus.gnss.value[fix, 3:]
-    lat0 = math.radians(site.latitude_deg)
+    latitude, longitude = latitude_longitude_deg(r[:, 0], r[:, 1], site.latitude_deg, site.longitude_deg)
     return {
         "imu": pd.DataFrame({"t_s": t[imu],
                              **{f"acc_{a}_mps2": acc[:, i] for i, a in enumerate("xyz")},
@@ -80,8 +79,7 @@ def _frames(bus, t, keep, site) -> dict[str, pd.DataFrame]:
                              **{f"mag_{a}": mag[:, i] for i, a in enumerate("xyz")}}),
         "baro": pd.DataFrame({"t_s": t[baro], "pressure_pa": bus.barometer.value[baro, 0]}),
         "gnss": pd.DataFrame({"t_s": t[fix],
-                              "lat_deg": site.latitude_deg + np.degrees(r[:, 0] / EARTH_RADIUS_M),
-                              "lon_deg": site.longitude_deg + np.degrees(r[:, 1] / (EARTH_RADIUS_M * math.cos(lat0))),
+                              "lat_deg": latitude, "lon_deg": longitude,
                               "vel_north_mps": v[:, 0], "vel_east_mps": v[:, 1], "vel_down_mps": v[:, 2],
                               "num_sats": np.full(len(r), np.nan)}),
     }  # fmt: skip

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import copy
+import functools
 import tomllib
 from importlib import resources
 
@@ -19,7 +21,14 @@ def part_names(sensor: str | None = None) -> list[str]:
 
 def load_part(name: str) -> dict:
     """The tables of part ``name``: its ``name``, ``description``, ``source`` and one table per sensor it
-    provides. KeyError (listing the known parts) if there is no such part."""
+    provides (a copy: the caller may change it). KeyError (listing the known parts) if there is no such part."""
+    return copy.deepcopy(_parsed(name))
+
+
+@functools.cache
+def _parsed(name: str) -> dict:
+    """Part ``name``'s file, read once: a campaign validates its [avionics] once per value its dispersions can
+    draw, each time reading every sensor's part."""
     path = PARTS / f"{name}.toml"
     if not (name.replace("_", "").isalnum() and path.is_file()):
         raise KeyError(f"unknown part {name!r} (known: {', '.join(part_names())})")
