@@ -164,7 +164,7 @@ def test_help_matches_the_readme(capsys):
     added without the README saying so fails) and the same choices where the README lists them."""
     documented = _readme_commands()
     assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
-                               ("sensors", "simulate"), ("validate",), ("bench",)}  # fmt: skip
+                               ("sensors", "simulate"), ("navigate",), ("validate",), ("bench",)}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]

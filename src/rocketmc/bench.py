@@ -7,7 +7,8 @@
 - ratios timed together in one process: the vmapped batch against single flights in a loop (every
   core; issue 6); in another, on one core and one thread, the costs per flight: the interpolated
   aerodynamics against the simplified (issue 6), the closed loop (perfect navigation) against the
-  same flights with the controller off (issue 16), the closed loop on raw sensors against it (issue 17).
+  same flights with the controller off (issue 16), the closed loop on raw sensors against it (issue 17), the full
+  GNC (navigation filters) against the controller off (issue 18).
 
 Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
 resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
@@ -107,11 +108,12 @@ def ratios(campaign, repeats: int = 3) -> dict:
 
 
 def costs(campaign, repeats: int = 3) -> dict:
-    """The cost ratios of issues 6, 16 and 17 on ``campaign``, per flight of vmapped batches (``_batch``), timed
+    """The cost ratios of issues 6, 16, 17 and 18 on ``campaign``, per flight of vmapped batches (``_batch``), timed
     together: the interpolated aerodynamics against the simplified (controller off), the closed loop (the
     campaign's [gnc] or its defaults, perfect navigation) against the same flights with the controller off
-    (simplified), and the closed loop on raw sensors (the campaign's [avionics] or the thesis's parts)
-    against the closed loop on perfect navigation. Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
+    (simplified), the closed loop on raw sensors (the campaign's [avionics] or the thesis's parts)
+    against the closed loop on perfect navigation, and the flights/s of the controller off against the full GNC
+    (the closed loop on the navigation filters). Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
     work a flight takes, and on one thread the best rounds of a function agree within ~5 % where the
     two-core rounds, whose threads wait on each other, spread ~10 % (measured on the 2-core VM)."""
     open_loop = campaign.with_overrides(aero_model="simplified", controller=False, sensors=False)
@@ -122,10 +124,12 @@ def costs(campaign, repeats: int = 3) -> dict:
         "interpolated": (compile_chunk, (open_loop.with_overrides(aero_model="interpolated"), batch), batch),
         "closed_loop": (compile_chunk, (closed_loop, batch), batch),
         "sensors": (compile_chunk, (closed_loop.with_overrides(sensors=True), batch), batch),
+        "filters": (compile_chunk, (closed_loop.with_overrides(navigation="filters"), batch), batch),
     }, repeats)  # fmt: skip
     return {"batch": batch, "s_per_flight": s, "interpolated_over_simplified": s["interpolated"] / s["simplified"],
             "closed_over_open_loop": s["closed_loop"] / s["simplified"],
-            "sensors_over_closed_loop": s["sensors"] / s["closed_loop"]}  # fmt: skip
+            "sensors_over_closed_loop": s["sensors"] / s["closed_loop"],
+            "full_gnc_speed_over_open_loop": s["simplified"] / s["filters"]}  # fmt: skip
 
 
 @contextlib.contextmanager
@@ -307,7 +311,8 @@ def run_benchmarks(
     c = report["costs"] = measure("costs", path, precisions[0])
     log(f"costs ({precisions[0]}, one core): interpolated {c['interpolated_over_simplified']:.2f}x the simplified, "
         f"closed loop {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s, sensors "
-        f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost")  # fmt: skip
+        f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost, the full GNC (filters) "
+        f"{c['full_gnc_speed_over_open_loop']:.2f}x the open loop's flights/s")  # fmt: skip
     return report
 
 
@@ -362,7 +367,9 @@ def format_report(report: dict) -> str:
         f"{c['interpolated_over_simplified']:.2f}x ({1e3 * s['interpolated']:.2f} against {1e3 * s['simplified']:.2f} "
         f"ms); closed loop (perfect navigation, simplified) {1 / c['closed_over_open_loop']:.2f}x the flights/s "
         f"of the same flights with the controller off ({1e3 * s['closed_loop']:.2f} ms); on raw sensors "
-        f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost ({1e3 * s['sensors']:.2f} ms)"
+        f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost ({1e3 * s['sensors']:.2f} ms); the full GNC "
+        f"(thesis sensors, MEKF and Kalman filter) {c['full_gnc_speed_over_open_loop']:.2f}x the flights/s of the "
+        f"controller off ({1e3 * s['filters']:.2f} ms)"
     )
     return "\n".join(lines)
 

@@ -1,7 +1,7 @@
 """The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``compare`` the
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
-a campaign, ``sensors simulate``: one realization's sensor log, ``validate`` the simulation against a real
-flight, ``bench`` this machine."""
+a campaign, ``sensors simulate``: one realization's sensor log, ``navigate``: the navigation filters replayed on
+a sensor log, ``validate`` the simulation against a real flight, ``bench`` this machine."""
 
 from __future__ import annotations
 
@@ -287,6 +287,81 @@ def _sensors_simulate(args) -> int:
     return 0
 
 
+def _site_campaign(name: str):
+    """The campaign of ``navigate --site``: a campaign file, or the name of one shipped in data/campaigns."""
+    from importlib import resources
+
+    if name.endswith(".toml") or os.sep in name:
+        return _campaign(name)
+    shipped = resources.files("rocketmc") / "data" / "campaigns"
+    if not (shipped / f"{name}.toml").is_file():
+        known = sorted(p.name.removesuffix(".toml") for p in shipped.iterdir() if p.name.endswith(".toml"))
+        raise RocketmcError(f"--site {name}: neither a campaign file nor a shipped campaign ({', '.join(known)})")
+    return _campaign(Path(str(shipped / f"{name}.toml")))
+
+
+def _navigate(args) -> int:
+    from .analysis import replay as nav_replay
+    from .analysis.sensor_log import read_sensor_log
+    from .campaign.config import FiltersConfig
+    from .campaign.model import filter_params
+    from .files import replacing
+
+    out = None if args.out is None else _output_file("--out", args.out, (".csv",))
+    campaign = _site_campaign(args.site)
+    config = campaign.config
+    if (FiltersConfig() if config.gnc is None else config.gnc.filters).initialisation == "pad":
+        raise RocketmcError(f'{args.site}: gnc.filters.initialisation = "pad" initialises on pad samples, and a log '
+                            'starts at liftoff (use "rail")')  # fmt: skip
+    if not Path(args.log_dir).is_dir():
+        raise RocketmcError(f"{args.log_dir}: no such folder (a sensor log: imu, baro and gnss CSV files)")
+    try:
+        log = read_sensor_log(args.log_dir)
+    except ValueError as e:
+        raise RocketmcError(str(e)) from None
+    if args.plot:  # before the replay: a folder that cannot be made is said at once
+        Path(args.plot).mkdir(parents=True, exist_ok=True)
+    params = nav_replay.retuned(filter_params(campaign), None if args.barometer is None else args.barometer == "on",
+                                args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std)  # fmt: skip
+    launch, site = config.launch, config.site
+    say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    say(f"{args.log_dir}: {len(log['imu'])} IMU ticks, {len(log['baro'])} barometer and {len(log['gnss'])} GNSS "
+        f"samples; {config.name}'s site and rail ({launch.elevation_deg:g}° toward {launch.azimuth_deg:g}°) "
+        "(compiling, then replaying)")  # fmt: skip
+    nav = nav_replay.replay(log, params, nav_replay.rail_attitude(launch.elevation_deg, launch.azimuth_deg), site)
+    try:
+        windows = nav_replay.flight_windows(nav, log)
+    except ValueError as e:
+        raise RocketmcError(f"{args.log_dir}: {e}") from None
+    m = nav_replay.navigation_metrics(nav, log, windows)
+    (burnout, apogee), landing = windows["coast"], windows["descent"][1]
+    top = int(nav["height_m"].idxmax())
+    gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
+    print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
+          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'}, field direction σ "
+          f"{float(params.attitude.field_direction_std):g}")  # fmt: skip
+    print(f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
+          f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {nav_replay.pad_pressure(nav):.1f} Pa")  # fmt: skip
+    print(f"  estimated apogee {nav['height_m'][top]:.1f} m at {nav['t_s'][top]:.2f} s"
+          + ("; the covariance failed, estimates held from then" if nav["failed"].any() else ""))  # fmt: skip
+    print(f"  {'against the log':<46}{'RMS':>8}{'max':>8}")
+    rows = [("height − barometric height, coast [m]", "height_{}_coast_m"),
+            ("height − barometric height, descent [m]", "height_{}_descent_m"),
+            ("flight-path angle − GNSS's, coast [deg]", "gamma_{}_coast_deg"),
+            ("heading − GNSS's, coast [deg]", "heading_{}_coast_deg"),
+            ("body x axis to GNSS velocity, coast [deg]", "body_to_velocity_{}_coast_deg")]  # fmt: skip
+    for label, key in rows:
+        print(f"  {label:<46}{m[key.format('rms')]:>8.2f}{m[key.format('max')]:>8.2f}")
+    if out:
+        with replacing(out) as partial:
+            nav.to_csv(partial, index=False, lineterminator="\n")
+        say(f"wrote {out}: {len(nav)} ticks")
+    if args.plot:
+        for path in nav_replay.plot_navigation({config.name: nav}, log, windows, args.plot, Path(args.log_dir).name):
+            say(f"wrote {path}")
+    return 0
+
+
 MAX_STATIC_S = 86_400.0
 """Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
 MAX_MACH = 10.0
@@ -412,6 +487,25 @@ def main(argv: list[str] | None = None) -> int:
                           help="instead, the rocket at rest on the pad for this long (noise analysis)")  # fmt: skip
     simulate.add_argument("--out", required=True, metavar="DIR", help="folder for the CSV files")
     simulate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
+    navigate = commands.add_parser(
+        "navigate", help="the navigation filters replayed on a sensor log (the real Roccaraso one or a simulated one)")
+    navigate.add_argument("log_dir", metavar="LOG_DIR", help="folder of the log's CSV files (imu, baro, gnss)")
+    navigate.add_argument("--site", default="lynx_roccaraso_2021", metavar="NAME|CAMPAIGN.toml",
+                          help="the campaign whose site, rail (the attitude at liftoff) and [gnc.filters] tuning are "
+                               "used: a shipped campaign's name or a campaign file (default: lynx_roccaraso_2021)")  # fmt: skip
+    navigate.add_argument("--out", metavar="NAV.csv", help="write the estimates at every tick to this CSV file")
+    navigate.add_argument("--plot", metavar="DIR", help="folder for the figures (height, velocity, its direction, attitude)")
+    navigate.add_argument("--barometer", choices=("on", "off"), help="the barometric height update (default: the campaign's)")
+    navigate.add_argument("--gnss", choices=("all", "horizontal"),
+                          help="GNSS updates of every axis or of north and east only (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--gnss-after", type=float, metavar="S",
+                          help="use GNSS fixes from S seconds after liftoff (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--gnss-std", type=float, nargs=2, metavar=("M", "MPS"),
+                          help="the GNSS's position [m] and velocity [m/s] standard deviations, every axis "
+                               "(default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--field-direction-std", type=float, metavar="S",
+                          help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
     validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
@@ -454,8 +548,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
         parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
                      f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
+    if args.command == "navigate":
+        spreads = [*(args.gnss_std or ()), *(() if args.field_direction_std is None else (args.field_direction_std,))]
+        if not all(0 < v < float("inf") for v in spreads) or not 0 <= (args.gnss_after or 0.0) < float("inf"):
+            parser.error("--gnss-std and --field-direction-std must be positive, --gnss-after at least 0")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
-               "sensors": _sensors_simulate, "validate": _validate, "bench": _bench}  # fmt: skip
+               "sensors": _sensors_simulate, "navigate": _navigate, "validate": _validate, "bench": _bench}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

@@ -29,9 +29,9 @@ from rocketmc.cli import main
 from ..conftest import CAMPAIGNS
 from .test_resume import assert_same, contents
 
-CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic_ctrl_1s.toml")  # the controller on (flown on raw sensors: ARGS)
+CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")  # the full GNC: sensors, navigation filters, controller
 N, CHUNK, SEED = 16, 2, 7  # 8 chunks of ~0.5 s on one worker core once compiled
-ARGS = ["-n", str(N), "--chunk-size", str(CHUNK), "--seed", str(SEED), "--sensors", "on"]  # raw sensors
+ARGS = ["-n", str(N), "--chunk-size", str(CHUNK), "--seed", str(SEED)]
 
 
 def test_two_workers_write_the_local_bits(tmp_path, monkeypatch):
@@ -58,7 +58,7 @@ def test_two_workers_write_the_local_bits(tmp_path, monkeypatch):
         assert got_attrs["campaign_toml"] == want_attrs["campaign_toml"]
         assert list(got_attrs["completed_chunks"]) == list(range(N // CHUNK))
 
-        campaign = load_campaign(CAMPAIGN).with_overrides(n_realizations=N, seed=SEED, sensors=True)
+        campaign = load_campaign(CAMPAIGN).with_overrides(n_realizations=N, seed=SEED)
         resumes(address, campaign, want, tmp_path / "resumed.h5")
         stops_early(client, campaign)
         refuses_workers_unlike_the_client(client, campaign)

@@ -1,5 +1,6 @@
-"""A run killed with SIGKILL and resumed gives the same result file as an uninterrupted one (the controller
-on, under parachutes); foreign or damaged partial runs are refused, never overwritten."""
+"""A run killed with SIGKILL and resumed gives the same result file as an uninterrupted one (the full GNC: the
+thesis's sensors, the navigation filters and the controller, under parachutes); foreign or damaged partial runs are
+refused, never overwritten."""
 
 from __future__ import annotations
 
@@ -16,8 +17,8 @@ import numpy as np
 
 from rocketmc.cli import main
 
-CAMPAIGN = str(Path(__file__).parents[2] / "campaigns" / "lynx_nominal_ctrl_1s.toml")
-ARGS = ["-n", "160", "--chunk-size", "16", "--seed", "5", "--sensors", "on"]  # 10 chunks of ~0.2 s each after compilation; the controller on raw sensors
+CAMPAIGN = str(Path(__file__).parents[2] / "campaigns" / "lynx_nominal_gnc_1s.toml")
+ARGS = ["-n", "160", "--chunk-size", "16", "--seed", "5"]  # 10 chunks of ~0.3 s each after compilation
 
 
 def contents(path):

@@ -41,14 +41,16 @@ bias_std = [0.2, 0.2, 0.2, 0.2]
 
 
 @pytest.mark.parametrize("name, sensors", [("lynx_nominal", False), ("lynx_ballistic_ctrl_1s", False),
-                                           ("lynx_ballistic_ctrl_1s", True)])  # fmt: skip
+                                           ("lynx_ballistic_ctrl_1s", True), ("lynx_ballistic_gnc_1s", False)])  # fmt: skip
 def test_same_bits_for_any_chunk_size(name, sensors):
     # Chunks of 5 (compiled batches of 16 flights, 8 per core, a padded last chunk) against chunks of
     # 20 (batches of 32): the same realizations with turbulence, mass, thrust and wind draws, open loop,
-    # and with the controller on and its servos dispersed, on perfect navigation and on raw sensors (datasheet
-    # parts: their turn-on biases drawn per flight, their noise per block).
+    # and with the controller on and its servos dispersed, on perfect navigation, on raw sensors (datasheet
+    # parts: their turn-on biases drawn per flight, their noise per block) and on the navigation filters (the
+    # thesis's sensors, their walks and noise per block).
     path = CAMPAIGNS / f"{name}.toml"
-    text = path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if "ctrl" in name else "[dispersions]\n")
+    closed_loop = "ctrl" in name or "gnc" in name
+    text = path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if closed_loop else "[dispersions]\n")
     if sensors:
         text = text.replace('navigation = "truth"', 'navigation = "sensors"').replace("[dispersions]", SENSORS + "[dispersions]")
     campaign = parse_campaign(text, path.parent).with_overrides(n_realizations=24)
@@ -61,7 +63,9 @@ def test_same_bits_for_any_chunk_size(name, sensors):
         np.testing.assert_array_equal(a_in[name], b_in[name], err_msg=name)
     assert np.all(a_out["status"] == 0)
     assert len(np.unique(a_out["impact_north_m"])) == 24  # the realizations do differ
-    if "ctrl" in name:
+    if closed_loop:
         assert len(np.unique(a_in["gnc.servo.time_constant_s"])) == 24 and np.all(a_out["control_active_time_s"] > 8.9)
+    if "gnc" in name:  # the filters' outputs, each flight its own
+        assert len(np.unique(a_out["attitude_error_rms_window_rad"])) == 24
     if sensors:  # the drawn turn-on biases are inputs, one per axis
         assert len(np.unique(a_in["avionics.gyroscope.bias.2"])) == 24 and "avionics.canard_feedback.bias.3" in a_in

@@ -337,13 +337,22 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[gnc]\nnavigation = "sensors"', "gnc.navigation"),
         ("[dispersions]", '[avionics]\n\n[dispersions]\n"avionics.gnss.rate_hz" = { dist = "normal", std = 1.0 }',
          "dispersions.avionics.gnss.rate_hz"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
+         "[gnc.filters.attitude]\ngyro_noise_deg_s = 0.0", "gnc.filters.attitude.gyro_noise_deg_s"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc.filters.position]\n'
+         "gnss_velocity_std_mps = [50.0, -50.0, 70.0]", "gnc.filters.position.gnss_velocity_std_mps.1"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
+         '[gnc.filters]\ninitialisation = "pad"', "gnc.filters.initialisation"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[gnc]\nnavigation = "filters"', "gnc.navigation"),
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
          "long-name", "binary-thrust-file", "binary-aero-csv", "elevation-above-90", "negative-mass", "missing-n",
          "unknown-key", "missing-table-file", "unknown-aero-model", "fixed-field-dispersed", "gnc-window-order",
          "gnc-grid-outside-flight", "gnc-no-canard-authority", "gnc-control-dispersed", "gnc-offset-beyond-limit",
          "unknown-part", "part-without-the-sensor", "negative-noise-density", "rate-not-dividing-the-gnc-rate",
-         "range-without-zero", "latency-between-ticks", "sensor-navigation-without-avionics", "sensor-rate-dispersed"],
+         "range-without-zero", "latency-between-ticks", "sensor-navigation-without-avionics", "sensor-rate-dispersed",
+         "filter-covariance-zero", "filter-covariance-negative", "pad-initialisation-without-pad-time",
+         "filters-without-avionics"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old
@@ -393,10 +402,14 @@ def test_any_number_anywhere_loads_finite_or_names_the_field(keys, value):
 
 GNC = {
     **replaced(EXPANDED, "rocket.aero.model", "linear"),
-    "gnc": {"servo": {}, "guidance": {}, "control": {}},
-}
+    "gnc": {"servo": {}, "guidance": {}, "control": {},
+            "filters": {"pad_samples": 500, "attitude": {"gyro_noise_deg_s": 60.0, "field_direction_std": 2.0},
+                        "position": {"gnss_after_s": 10.5, "gnss_velocity_std_mps": [50.0, 50.0, 70.0],
+                                     "altitude_std_m": 4.2}}},
+}  # fmt: skip
 """The expanded nominal campaign with the thesis's closed loop on the thesis's linear model (its gains
-designed in ~0.3 s); every case below edits it once."""
+designed in ~0.3 s), a few of the navigation filters' numbers spelt out (for the fuzz below); every case below
+edits it once."""
 
 
 def test_gnc_base_is_valid():
@@ -428,6 +441,13 @@ def test_gnc_base_is_valid():
          "gnc.servo.offset_deg: each offset must be smaller in magnitude than limit_deg (10.0), got [0.0, 10.0, 0.0, 0.0]"),
         ("gnc.servo.offset_deg", [0.0, 0.0, 0.0], "gnc.servo.offset_deg: List should have at least 4 items"),
         ("gnc.navigation", "ekf", "gnc.navigation: Input should be 'truth'"),
+        ("gnc.filters.attitude.field_direction_std", -2.0,
+         "gnc.filters.attitude.field_direction_std: Input should be greater than 0 (got -2.0)"),
+        ("gnc.filters.position.initial_velocity_std_mps", 0.0,
+         "gnc.filters.position.initial_velocity_std_mps: Input should be greater than 0 (got 0.0)"),
+        ("gnc.filters.position.gnss", "vertical", "gnc.filters.position.gnss: Input should be 'all' or 'horizontal'"),
+        ("gnc.filters.pad_samples", 0, "gnc.filters.pad_samples: Input should be greater than or equal to 1"),
+        ("gnc.filters.initialisation", "triad", "gnc.filters.initialisation: Input should be 'rail' or 'pad'"),
     ],
 )  # fmt: skip
 def test_bad_gnc_fields_are_refused_naming_the_field(path, value, message_start):
@@ -485,7 +505,7 @@ def test_gnc_needs_four_canards():
     ("path", "dispersion", "message_start"),
     [
         ("gnc.control.r_weights.0", {"dist": "normal", "std": 1.0}, "dispersions.gnc.control.r_weights.0: fixed for the "
-         "whole campaign (guidance and the LQI gains are set once, when it loads); only the servos"),
+         "whole campaign (guidance, the LQI gains and the navigation filters are set once, when it loads); only the servos"),
         ("gnc.guidance.window_start_s", {"dist": "uniform", "low": 1.0, "high": 3.5},
          "dispersions.gnc.guidance.window_start_s: fixed for the whole campaign"),
         ("gnc.servo.limit_deg", {"dist": "normal", "std": 2.0}, "dispersions.gnc.servo.limit_deg: draws a value -2.0 "

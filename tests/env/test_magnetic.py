@@ -26,7 +26,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.env.magnetic import DipoleCoefficients, dipole_field_ned, igrf_dipole, site_field_ned
+from rocketmc.env.magnetic import DipoleCoefficients, dipole_field_ned, igrf_dipole, site_field_gradient, site_field_ned
 
 SITES = {  # geodetic latitude [deg], longitude [deg], altitude above sea level [m]
     "roccaraso": (41.8087, 14.0543, 1416.0),
@@ -177,3 +177,32 @@ def test_falls_as_inverse_cube_of_radius():
     b = ned(jax.vmap(dipole_field_ned, in_axes=(None, None, None, 0))(c, lat, lon, altitudes))
     ratio = (6371200.0 / (6371200.0 + np.asarray(altitudes))) ** 3
     np.testing.assert_allclose(b / b[:, :1], np.broadcast_to(ratio, b.shape), rtol=1e-13)
+
+
+@pytest.mark.parametrize("site", SITES)
+def test_gradient_in_the_sites_axes(site):
+    # The field at a point offset from the site, in the site's NED axes (the flat Earth's), by central differences
+    # of the ECEF closed form (a second formulation: no latitudes, no local axes at the offset point). Steps of 10 m
+    # against a field that changes on the Earth's scale (a/3 ≈ 2000 km): truncation ~(10/2e6)² ~ 3e-11 of the
+    # gradient, roundoff ~1e-16·|B|/10 m; 1e-7 of the gradient's size leaves room for both.
+    lat, lon, alt = SITES[site]
+    field, gradient = site_field_gradient(lat, lon, alt)
+    c = igrf_dipole()
+    a = float(c.radius_m)
+    g = 1e-9 * np.array([float(c.g11_nt), float(c.h11_nt), float(c.g10_nt)])
+    sl, cl, so, co = (f(math.radians(x)) for f, x in ((np.sin, lat), (np.cos, lat), (np.sin, lon), (np.cos, lon)))
+    ecef_to_ned = np.array([[-sl * co, -sl * so, cl], [-so, co, 0.0], [-cl * co, -cl * so, -sl]])
+    centre = (a + alt) * np.array([cl * co, cl * so, sl])
+
+    def at(offset_n):
+        r = centre + ecef_to_ned.T @ offset_n
+        r_hat = r / np.linalg.norm(r)
+        return ecef_to_ned @ ((a / np.linalg.norm(r)) ** 3 * (3.0 * (g @ r_hat) * r_hat - g))
+
+    step = 10.0
+    reference = np.stack([(at(step * e) - at(-step * e)) / (2 * step) for e in np.eye(3)], axis=1)
+    np.testing.assert_allclose(field, at(np.zeros(3)), rtol=1e-12)
+    np.testing.assert_allclose(gradient, reference, rtol=0, atol=1e-7 * np.abs(reference).max())
+    # A field with a potential in free space: the gradient is symmetric (curl-free) and traceless (divergence-free)
+    np.testing.assert_allclose(gradient, gradient.T, rtol=0, atol=1e-12 * np.abs(gradient).max())
+    assert abs(np.trace(gradient)) < 1e-12 * np.abs(gradient).max()

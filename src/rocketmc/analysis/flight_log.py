@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import savgol_filter
 
-from ..env.atmosphere import troposphere_altitude
+from ..env.atmosphere import pressure_height_m
 from ..env.site import north_east_m
 
 ROCCARASO_2021 = resources.files("rocketmc") / "data" / "flights" / "roccaraso_2021"
@@ -93,9 +93,11 @@ class FlightLog:
     description: str
 
 
-def _read_stream(path: Traversable, period_s: float | None, columns: dict[str, str]) -> pd.DataFrame:
-    """One CSV stream as ``t_s`` plus ``columns`` renamed; errors name the file. ``period_s`` None:
-    the last ``t_nominal_s`` / (rows − 1)."""
+def _read_stream(path: Traversable, period_s: float | None, columns: dict[str, str],
+                 optional: tuple[str, ...] = ()) -> pd.DataFrame:  # fmt: skip
+    """One CSV stream as ``t_s`` = the first ``t_nominal_s`` + sample × period [s] plus ``columns`` renamed;
+    errors name the file. ``period_s`` None: the span of ``t_nominal_s`` / (rows − 1); ``optional``: columns
+    that may hold no number (a simulated log's satellite count)."""
     if not path.is_file():
         raise FileNotFoundError(f"{path}: flight log file not found")
     try:
@@ -107,17 +109,19 @@ def _read_stream(path: Traversable, period_s: float | None, columns: dict[str, s
     if missing := [c for c in needed if c not in raw]:
         raise ValueError(f"{path}: missing columns {', '.join(missing)}")
     values = raw[needed].apply(pd.to_numeric, errors="coerce")
-    if not np.isfinite(values.to_numpy(dtype=float)).all():
-        raise ValueError(f"{path}: every row needs finite numbers in {', '.join(needed)}")
+    required = [c for c in needed if c not in optional]
+    if not np.isfinite(values[required].to_numpy(dtype=float)).all():
+        raise ValueError(f"{path}: every row needs finite numbers in {', '.join(required)}")
     if not np.array_equal(values["sample"], np.arange(len(values))):
         raise ValueError(f"{path}: sample must count 0, 1, 2, ... without gaps")
+    first = float(values["t_nominal_s"].iloc[0]) if len(values) else 0.0
     if period_s is None:
         if len(values) < 2:
             raise ValueError(f"{path}: two samples or more needed for the period")
-        period_s = float(values["t_nominal_s"].iloc[-1]) / (len(values) - 1)
-    t_s = values["sample"].to_numpy() * period_s
+        period_s = (float(values["t_nominal_s"].iloc[-1]) - first) / (len(values) - 1)
+    t_s = first + values["sample"].to_numpy() * period_s
     if not np.allclose(values["t_nominal_s"], t_s, rtol=0.0, atol=1e-3):
-        raise ValueError(f"{path}: t_nominal_s is not sample × {period_s} s")
+        raise ValueError(f"{path}: t_nominal_s is not {first} s + sample × {period_s} s")
     return pd.concat([pd.Series(t_s, name="t_s"), values[list(columns)].rename(columns=columns)], axis=1)
 
 
@@ -136,8 +140,7 @@ def load_roccaraso_2021() -> FlightLog:
 
 def pressure_altitude_agl_m(pressure_pa, pad_pressure_pa):
     """Geometric height [m] of the ISA troposphere level at ``pressure_pa`` above the one at ``pad_pressure_pa``."""
-    pressure = np.asarray(pressure_pa, dtype=float)
-    return troposphere_altitude(pressure) - troposphere_altitude(float(pad_pressure_pa))
+    return pressure_height_m(np.asarray(pressure_pa, dtype=float), float(pad_pressure_pa))
 
 
 @dataclass(frozen=True)

@@ -62,8 +62,8 @@ CHANNELS = {
 
 
 def write_sensor_log(directory: str | os.PathLike, streams: dict[str, pd.DataFrame]) -> None:
-    """Write each stream of ``streams`` (names of ``LOG_FILES``: a frame of ``t_s`` [s since liftoff,
-    k × period from 0] and the header's value columns) as its CSV in ``directory`` (created if need be):
+    """Write each stream of ``streams`` (names of ``LOG_FILES``: a frame of ``t_s`` [s since liftoff, its first
+    sample's time + k × period] and the header's value columns) as its CSV in ``directory`` (created if need be):
     ``sample`` from 0, ``t_nominal_s`` to 1 ms, values to 10 significant digits."""
     root = Path(directory)
     root.mkdir(parents=True, exist_ok=True)
@@ -81,9 +81,10 @@ def write_sensor_log(directory: str | os.PathLike, streams: dict[str, pd.DataFra
 
 def read_sensor_log(directory: str | os.PathLike | Traversable) -> dict[str, pd.DataFrame]:
     """The three streams of a sensor log (the real one: ``flight_log.ROCCARASO_2021``) as frames of
-    ``t_s`` = sample × period [s] and the value columns named as in the CSV headers."""
+    ``t_s`` = the first sample's time + sample × period [s] and the value columns named as in the CSV headers
+    (a simulated log's ``num_sats`` is NaN: not modelled)."""
     root = Path(directory) if isinstance(directory, (str, os.PathLike)) else directory
-    return {name: _read_stream(root / file, None, {c: c for c in header[2:]})
+    return {name: _read_stream(root / file, None, {c: c for c in header[2:]}, optional=("num_sats",))
             for name, (file, header) in LOG_FILES.items()}  # fmt: skip
 
 

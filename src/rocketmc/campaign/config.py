@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import hashlib
+import math
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -39,9 +40,9 @@ FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "roc
 """Numbers that define the body frame or build the aerodynamic tables once per campaign: not
 dispersible, except those of ``DISPERSIBLE_AERO``."""
 DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.linear.")
-FIXED_GNC = ("gnc.guidance.", "gnc.control.")
-"""Guidance and the gain design, set once per campaign (the gains are designed when it loads): not
-dispersible; the servos (``gnc.servo``) are."""
+FIXED_GNC = ("gnc.guidance.", "gnc.control.", "gnc.filters.")
+"""Guidance, the gain design and the navigation filters' tuning, set once per campaign (the gains are designed
+when it loads): not dispersible; the servos (``gnc.servo``) are."""
 FIXED_AVIONICS = ("rate_hz", "latency_s", *("_std", "_std_deg"))
 """Ends of the avionics' numbers that are not dispersible: the schedule (rate, latency) is set per campaign,
 and the per-flight spreads are dispersions themselves."""
@@ -543,15 +544,66 @@ class ControlConfig(_Strict):
         return grid
 
 
-class GncConfig(_Strict):
-    """The closed loop: canard servos, guidance, LQI control; navigation "truth" (the true state) or "sensors"
-    (raw sensors from the avionics bus: gyro rates, GNSS fixes held between fixes, the launch attitude
-    propagated by the gyro; needs [avionics])."""
+ONE_RAD_DEG = math.degrees(1.0)
+"""The thesis's initial covariances are identities: 1 rad and 1 rad/s, in the campaign's degrees."""
+StdDeviation = Annotated[float, Field(gt=0, le=MAX_SENSOR_VALUE)]
 
-    navigation: Literal["truth", "sensors"] = "truth"
+
+class AttitudeFilterConfig(_Strict):
+    """The MEKF's tuning (GNC.md §2, ``gnc.attitude_filter``), the thesis's values as defaults: the gyro's white
+    noise σ_v [deg/s/√s] and its bias's random walk σ_u [deg/s²/√s] (knobs about 10³ above the thesis gyro's own:
+    the filter follows the magnetometer within ~0.3 s), the measured field direction's standard deviation [-] (a
+    unit vector; the thesis's R = 4 I), the initial standard deviations of the attitude [deg] and gyro bias
+    [deg/s] per axis (the thesis's P0 = I)."""
+
+    gyro_noise_deg_s: StdDeviation = 60.0
+    bias_walk_deg_s2: StdDeviation = 10.0
+    field_direction_std: StdDeviation = 2.0
+    initial_attitude_std_deg: StdDeviation = ONE_RAD_DEG
+    initial_bias_std_deg_s: StdDeviation = ONE_RAD_DEG
+
+
+class PositionFilterConfig(_Strict):
+    """The position/velocity Kalman filter's tuning (GNC.md §3, ``gnc.position_filter``), the thesis's values as
+    defaults: process noise on position [m/√s] and velocity [m/s/√s]; the GNSS fixes used from ``gnss_after_s``
+    (simulation time [s]), on every axis ("all") or north and east only ("horizontal", Skyward's avionics),
+    with their standard deviations N, E, D (the thesis's, de-weighted ~100×); the barometric height update (off in
+    the thesis) and its standard deviation [m]; the initial standard deviations (the thesis's P0 = I)."""
+
+    position_noise_m: StdDeviation = 2.0
+    velocity_noise_mps: StdDeviation = 1.0
+    gnss: Literal["all", "horizontal"] = "all"
+    gnss_after_s: float = Field(10.5, ge=0, le=MAX_FLIGHT_TIME_S)
+    gnss_position_std_m: list[StdDeviation] = Field([500.0, 500.0, 700.0], min_length=3, max_length=3)
+    gnss_velocity_std_mps: list[StdDeviation] = Field([50.0, 50.0, 70.0], min_length=3, max_length=3)
+    barometer: bool = False
+    altitude_std_m: StdDeviation = 5.0
+    initial_position_std_m: StdDeviation = 1.0
+    initial_velocity_std_mps: StdDeviation = 1.0
+
+
+class FiltersConfig(_Strict):
+    """The navigation filters of ``navigation = "filters"``: initialised from the launch rail's elevation and
+    azimuth ("rail") or from the mean of ``pad_samples`` accelerometer and magnetometer samples on the pad (TRIAD,
+    "pad": the motor must light after them, ``rocket.motor.ignition_delay_s``); their tunings."""
+
+    initialisation: Literal["rail", "pad"] = "rail"
+    pad_samples: int = Field(500, ge=1, le=100_000)
+    attitude: AttitudeFilterConfig = AttitudeFilterConfig()
+    position: PositionFilterConfig = PositionFilterConfig()
+
+
+class GncConfig(_Strict):
+    """The closed loop: canard servos, guidance, LQI control; navigation "truth" (the true state), "sensors"
+    (raw sensors from the avionics bus: gyro rates, GNSS fixes held between fixes, the launch attitude
+    propagated by the gyro; needs [avionics]) or "filters" (the MEKF and the position/velocity Kalman filter
+    on the bus, ``filters``; needs [avionics])."""
+
+    navigation: Literal["truth", "sensors", "filters"] = "truth"
     servo: ServoConfig = ServoConfig()
     guidance: GuidanceConfig = GuidanceConfig()
     control: ControlConfig = ControlConfig()
+    filters: FiltersConfig = FiltersConfig()
 
 
 DEFAULT_PART = "thesis"
@@ -800,13 +852,16 @@ class Campaign:
 
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
-        controller: bool | None = None, sensors: bool | None = None,
+        controller: bool | None = None, sensors: bool | None = None, navigation: str | None = None,
     ) -> Campaign:  # fmt: skip
         """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
         True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
         (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
-        (the thesis's parts) if there is none and flies the controller on raw sensors, False removes it and its
-        dispersions and flies the controller on perfect navigation."""
+        (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
+        campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
+        perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match."""
+        if navigation is not None:
+            sensors = navigation != "truth"
         data = self.config.model_dump()
         data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
         if aero_model is not None:
@@ -816,7 +871,8 @@ class Campaign:
                 data[section] = {} if on else None
                 data["dispersions"] = {k: d for k, d in data["dispersions"].items() if on or not k.startswith(section + ".")}
         if sensors is not None and data["gnc"] is not None:
-            data["gnc"]["navigation"] = "sensors" if sensors else "truth"
+            kept = data["gnc"]["navigation"] if data["gnc"]["navigation"] != "truth" else "sensors"
+            data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
         config = _validate(data)
         config = _with_sensor_spreads(config)
         campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
@@ -961,8 +1017,8 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
             raise ConfigError(f"{field}: fixed for the whole campaign (a sensor's schedule is set once, and its "
                               "per-flight spreads are dispersions already)")  # fmt: skip
         if path.startswith(FIXED_GNC):
-            raise ConfigError(f"{field}: fixed for the whole campaign (guidance and the LQI gains are set once, "
-                              "when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
+            raise ConfigError(f"{field}: fixed for the whole campaign (guidance, the LQI gains and the navigation "
+                              "filters are set once, when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
         if path not in nominal:
             raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
                               f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
@@ -1041,11 +1097,27 @@ def sample_period_ticks(config: CampaignConfig, sensor: str) -> int:
 
 def _check_avionics(config: CampaignConfig) -> None:
     """Sensor rates divide the GNC rate, latencies are whole GNC periods, raw-sensor navigation has sensors."""
-    if config.gnc is not None and config.gnc.navigation == "sensors" and config.avionics is None:
-        raise ConfigError("gnc.navigation: 'sensors' needs an [avionics] section (the sensors it reads)")
+    gnc = config.gnc
+    if gnc is not None and gnc.navigation != "truth" and config.avionics is None:
+        raise ConfigError(f"gnc.navigation: '{gnc.navigation}' needs an [avionics] section (the sensors it reads)")
+    if gnc is not None and gnc.navigation == "filters" and gnc.filters.initialisation == "pad":
+        _check_pad_samples(config)
     for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
         sample_period_ticks(config, sensor)
         sensor_ticks(config, getattr(config.avionics, sensor).latency_s, f"avionics.{sensor}.latency_s")
+
+
+def _check_pad_samples(config: CampaignConfig) -> None:
+    """ConfigError unless the motor lights after the filters' pad samples in every flight (the samples at the
+    GNC ticks before ignition)."""
+    pad = config.gnc.filters.pad_samples * config.simulation.control_dt_s
+    path = "rocket.motor.ignition_delay_s"
+    nominal, d = config.rocket.motor.ignition_delay_s, config.dispersions.get(path)
+    earliest = min([nominal] + ([] if d is None else [value for value, _ in _drawable_values(d, nominal, path)]))
+    if earliest < pad:
+        raise ConfigError(f"gnc.filters.initialisation: 'pad' needs {config.gnc.filters.pad_samples} samples on the "
+                          f"pad ({pad:g} s) before ignition, but {path} can be {earliest:g} s (raise it, lower "
+                          "gnc.filters.pad_samples, or initialise from the 'rail')")  # fmt: skip
 
 
 def _with_sensor_spreads(config: CampaignConfig) -> CampaignConfig:

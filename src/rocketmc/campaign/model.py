@@ -20,15 +20,18 @@ from ..dynamics.rigid_body import combine_on_axis
 from ..dynamics.servo import ServoParams
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
 from ..gnc.control import GAIN_NAMES, GncParams
+from ..gnc.attitude_filter import AttitudeTuning
 from ..gnc.guidance import GuidanceParams
+from ..gnc.navigation import FilterParams
+from ..gnc.position_filter import PositionTuning
 from ..math import Quat, Vec3
 from ..math.table import Table
-from ..env.magnetic import site_field_ned
+from ..env.magnetic import site_field_gradient, site_field_ned
 from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
 from ..sim.params import Environment, FlightParams, Launch, Rocket
-from .config import Campaign, sample_period_ticks, sensor_ticks
+from .config import Campaign, FiltersConfig, sample_period_ticks, sensor_ticks
 from .sampling import realization_key, stream_key
 
 
@@ -168,7 +171,28 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
         table = Table.from_numpy((schedule.speeds, schedule.altitudes), gains, ("speed", "altitude"), GAIN_NAMES)
     else:
         table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
-    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation)
+    filters = filter_params(campaign) if gnc.navigation == "filters" else None
+    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation, filters)
+
+
+def filter_params(campaign: Campaign) -> FilterParams:
+    """The navigation filters from the campaign's [gnc.filters] (fixed per campaign; its defaults without a [gnc]
+    section), in SI; the reference field of the site's geomagnetic model and its gradient along NED [T, T/m]."""
+    config = campaign.config
+    f, site = (FiltersConfig() if config.gnc is None else config.gnc.filters), config.site
+    a, p = f.attitude, f.position
+    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
+    attitude = AttitudeTuning(rad(a.gyro_noise_deg_s), rad(a.bias_walk_deg_s2), jnp.asarray(a.field_direction_std),
+                              rad(a.initial_attitude_std_deg), rad(a.initial_bias_std_deg_s))  # fmt: skip
+    position = PositionTuning(
+        jnp.asarray(p.position_noise_m), jnp.asarray(p.velocity_noise_mps), Vec3(*map(jnp.asarray, p.gnss_position_std_m)),
+        Vec3(*map(jnp.asarray, p.gnss_velocity_std_mps)), jnp.asarray(p.altitude_std_m),
+        jnp.asarray(p.initial_position_std_m), jnp.asarray(p.initial_velocity_std_mps),
+    )  # fmt: skip
+    with jax.ensure_compile_time_eval():  # the site's numbers: constants of the flight, even under jit
+        field_t, gradient = site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m)
+    return FilterParams(attitude, position, jnp.asarray(field_t), jnp.asarray(gradient), jnp.asarray(p.gnss_after_s),
+                        f.pad_samples if f.initialisation == "pad" else 0, p.gnss == "horizontal", p.barometer)  # fmt: skip
 
 
 SENSOR_UNITS = {"accelerometer": 1.0, "gyroscope": math.pi / 180.0, "magnetometer": 1e-6, "barometer": 1.0,

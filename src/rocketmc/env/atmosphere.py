@@ -88,3 +88,9 @@ def troposphere_altitude(pressure_pa):
     lapse = _LAPSE[0]
     geopotential = T0 / lapse * ((pressure_pa / P0) ** (-R_AIR * lapse / G0) - 1.0)
     return R_EARTH_GEOPOTENTIAL * geopotential / (R_EARTH_GEOPOTENTIAL - geopotential)
+
+
+def pressure_height_m(pressure_pa, reference_pressure_pa):
+    """Geometric height [m] of the ISA troposphere level at ``pressure_pa`` above the one at
+    ``reference_pressure_pa`` [Pa] (a barometer's height above the pad whose pressure it read; host or traced)."""
+    return troposphere_altitude(pressure_pa) - troposphere_altitude(reference_pressure_pa)

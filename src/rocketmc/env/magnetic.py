@@ -10,6 +10,7 @@ from __future__ import annotations
 import tomllib
 from importlib import resources
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -78,3 +79,28 @@ def site_field_ned(
     lat, lon = np.radians(latitude_deg), np.radians(longitude_deg)
     b = dipole_field_ned(igrf_dipole(decimal_year), lat, lon, altitude_m)
     return np.array([b.x, b.y, b.z], dtype=float)
+
+
+def site_field_gradient(latitude_deg, longitude_deg, altitude_m, decimal_year: float | None = None):
+    """(the dipole field [T] at a site given in degrees, its derivative along an offset from there [T/m] (3, 3)),
+    both in the site's NED axes (a flat Earth's), as numpy arrays: the field at the offset point of the sphere of
+    ``dipole_field_ned``, turned from that point's north, east, down into the site's."""
+    coefficients = igrf_dipole(decimal_year)
+
+    def ned_axes(lat, lon):  # rows: north, east, down in Earth-centred axes
+        sin_lat, cos_lat, sin_lon, cos_lon = jnp.sin(lat), jnp.cos(lat), jnp.sin(lon), jnp.cos(lon)
+        return jnp.array([[-sin_lat * cos_lon, -sin_lat * sin_lon, cos_lat], [-sin_lon, cos_lon, 0.0 * lat],
+                          [-cos_lat * cos_lon, -cos_lat * sin_lon, -sin_lat]])  # fmt: skip
+
+    site = ned_axes(np.radians(latitude_deg), np.radians(longitude_deg))
+    centre = -(coefficients.radius_m + altitude_m) * site[2]  # the site in Earth-centred axes
+
+    def field_t(offset_n):
+        point = centre + site.T @ offset_n
+        radius = jnp.linalg.norm(point)
+        lat, lon = jnp.arcsin(point[2] / radius), jnp.arctan2(point[1], point[0])
+        b = dipole_field_ned(coefficients, lat, lon, radius - coefficients.radius_m)
+        return 1e-9 * site @ (ned_axes(lat, lon).T @ jnp.stack([b.x, b.y, b.z]))
+
+    origin = jnp.zeros(3)
+    return np.asarray(field_t(origin), dtype=float), np.asarray(jax.jacfwd(field_t)(origin), dtype=float)

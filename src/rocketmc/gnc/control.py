@@ -24,7 +24,7 @@ from ..math import Quat, Vec3
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
 from .design import N_INPUT, N_PLANT, N_STATE
-from .navigation import DeadReckoning, initial_dead_reckoning
+from .navigation import DeadReckoning, FilterParams, FilterState, initial_dead_reckoning, initial_filters
 from .guidance import GuidanceParams, Navigation, guidance_active, integrate_errors, rate_command
 
 GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
@@ -37,13 +37,15 @@ class GncParams:
     """servo: the canard servos; guidance: the reference and the rate command; gains: ``Table`` of K over
     ``speed`` (axial body speed u [m/s]) and, when the design grid has several, ``altitude`` (above mean sea
     level [m]), outputs ``GAIN_NAMES`` (clamped at the grid's edges); anti_windup: conditional integration
-    (``gnc_step``; static); navigation: "truth" or "sensors" (``gnc.navigation``; static)."""
+    (``gnc_step``; static); navigation: "truth", "sensors" or "filters" (``gnc.navigation``; static); filters: the
+    navigation filters' parameters (None unless "filters")."""
 
     servo: ServoParams
     guidance: GuidanceParams
     gains: Table
     anti_windup: bool = static_field(default=True)
     navigation: str = static_field(default="truth")
+    filters: FilterParams | None = None
 
 
 @pytree_dataclass
@@ -53,7 +55,8 @@ class GncState:
     commands (yaw, pitch, roll) [rad]; saturated: they clipped a fin at its limit (bool). Flight totals for the outputs: active_time [s] with the controller
     active; tracking_sq, ∫χ² dt [rad²·s], and deflection_sq, ∫ mean over the fins of δ² dt [rad²·s], over that
     time; saturated_time [s] active with a fin saturated; max_deflection, the largest |δ| of any fin at a
-    period start [rad]. navigation: the raw-sensor navigation's state (``gnc.navigation``; None with "truth")."""
+    period start [rad]. navigation: the navigation's state (``gnc.navigation``: ``DeadReckoning`` with "sensors",
+    ``FilterState`` with "filters", None with "truth")."""
 
     servo: ServoState
     integrators: Vec3
@@ -65,16 +68,17 @@ class GncState:
     deflection_sq: jnp.ndarray
     saturated_time: jnp.ndarray
     max_deflection: jnp.ndarray
-    navigation: DeadReckoning | None = None
+    navigation: DeadReckoning | FilterState | None = None
 
 
-def initial_gnc(params: GncParams, like, q_nb0: Quat | None = None) -> GncState:
+def initial_gnc(params: GncParams, like, q_nb0: Quat | None = None, r_n0: Vec3 | None = None) -> GncState:
     """At rest on the rail: servos at their zero, integrators empty, no liftoff yet; ``like`` a scalar of the
-    flight's dtype; q_nb0: the launch attitude, where raw-sensor navigation starts (``params.navigation``
-    "sensors")."""
+    flight's dtype; q_nb0, r_n0: the launch attitude and the CG's position [m, NED], where navigation from the
+    sensors starts (``params.navigation`` "sensors" or "filters")."""
     zero = jnp.zeros_like(like)
     fins = jnp.zeros_like(params.servo.offset_rad)
-    navigation = initial_dead_reckoning(q_nb0) if params.navigation == "sensors" else None
+    navigation = {"truth": lambda: None, "sensors": lambda: initial_dead_reckoning(q_nb0),
+                  "filters": lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),

@@ -1,20 +1,36 @@
-"""Navigation from the avionics bus. For now ``navigation = "sensors"``: raw sensors, no filter (issue 18 adds
-the MEKF and the position/velocity Kalman filter), to show what raw sensors do to the closed loop.
+"""Navigation from the avionics bus: ``navigation = "sensors"``, raw sensors, and ``"filters"``, the MEKF
+(``attitude_filter``) and the position/velocity Kalman filter (``position_filter``).
 
 Raw sensors: body rates from the gyroscope, the launch attitude propagated by the gyroscope's rates (no
 correction: its bias and noise integrate), position and velocity from the GNSS, held between fixes (zero
-before the first fix), liftoff from the accelerometer.
+before the first fix), liftoff from the accelerometer (both modes).
+
+Filters (GNC.md §2-3), at each GNC tick t_k: position and velocity propagated from t_{k-1} with the accelerometer's
+sample of t_{k-1} (the bus delivers it at t_k) rotated into NED by the attitude estimate of t_{k-1}, plus gravity;
+the attitude propagated with the gyroscope's rates of t_{k-1} less the estimated bias; then the magnetometer's
+update of the attitude, the GNSS's and the barometer's of position and velocity; the a-posteriori estimate is the
+solution (the thesis fed the a-priori one forward, a tick late). Frames: NED from the pad, FRD body.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 import jax.numpy as jnp
 
-from ..env.atmosphere import G0
+from ..env.atmosphere import G0, pressure_height_m
 from ..math import Quat, Vec3
-from ..pytree import pytree_dataclass
-from ..sensors.avionics import Avionics, Bus
+from ..pytree import pytree_dataclass, static_field, tree_where
+from ..sensors.avionics import Avionics, Bus, to_body
+from .attitude_filter import (
+    AttitudeEstimate, AttitudeTuning, attitude_error_b, attitude_nees, initial_attitude, magnetometer_update, propagate_attitude,
+    rotation_step, triad,
+)  # fmt: skip
 from .guidance import Navigation
+from .position_filter import (
+    PositionEstimate, PositionTuning, altitude_update, gnss_update, initial_position, position_nees, propagate_position,
+)  # fmt: skip
 
 LIFTOFF_SPECIFIC_FORCE_MPS2 = 2.0 * G0
 """Liftoff is sensed once the accelerometer reads more than this along the rocket's axis: at rest on the rail
@@ -41,25 +57,12 @@ def initial_dead_reckoning(q_nb0: Quat) -> DeadReckoning:
     return DeadReckoning(zero, q_nb0, still, still, still)
 
 
-def rotation_step(omega_b: Vec3, dt) -> Quat:
-    """The quaternion of a rotation at constant body rates ω [rad/s] over dt [s]: (cos(θ/2), sin(θ/2)·ω/|ω|),
-    θ = |ω|·dt (exact for constant rates; smooth at ω = 0)."""
-    angle = omega_b.norm() * dt
-    half_sinc = 0.5 * dt * jnp.sinc(0.5 * angle / jnp.pi)  # sin(θ/2)/|ω|
-    return Quat(jnp.cos(0.5 * angle), omega_b.x * half_sinc, omega_b.y * half_sinc, omega_b.z * half_sinc)
-
-
-def _to_body(rotation, value) -> Vec3:
-    """A sensor-frame (3,) value in the body frame: the mounting rotation (body → sensor) transposed."""
-    return Vec3(*(sum(rotation[j, i] * value[j] for j in range(3)) for i in range(3)))
-
-
 def dead_reckoning(av: Avionics, state: DeadReckoning, bus: Bus, t) -> tuple[Navigation, DeadReckoning]:
     """The raw-sensor solution at time t [s]: the attitude propagated from the last solution with its rates,
     then the bus's gyroscope rates and GNSS fix (the last ones held when none is fresh)."""
     q_nb = (state.q_nb * rotation_step(state.omega_b, t - state.t)).normalized()
     gyro, gnss = bus.gyroscope, bus.gnss
-    omega_b = _to_body(av.gyroscope.rotation, gyro.value)
+    omega_b = to_body(av.gyroscope.rotation, gyro.value)
     omega_b = Vec3(*(jnp.where(gyro.valid, w, 0.0) for w in omega_b))
     r_n = Vec3(*(jnp.where(gnss.fresh, gnss.value[i], held) for i, held in enumerate(state.r_n)))
     v_n = Vec3(*(jnp.where(gnss.fresh, gnss.value[3 + i], held) for i, held in enumerate(state.v_n)))
@@ -69,4 +72,228 @@ def dead_reckoning(av: Avionics, state: DeadReckoning, bus: Bus, t) -> tuple[Nav
 def liftoff_sensed(av: Avionics, bus: Bus):
     """True when the accelerometer reads more than ``LIFTOFF_SPECIFIC_FORCE_MPS2`` along the rocket's axis."""
     accel = bus.accelerometer
-    return accel.valid & (_to_body(av.accelerometer.rotation, accel.value).x > LIFTOFF_SPECIFIC_FORCE_MPS2)
+    return accel.valid & (to_body(av.accelerometer.rotation, accel.value).x > LIFTOFF_SPECIFIC_FORCE_MPS2)
+
+
+# --- navigation = "filters": the MEKF and the position/velocity Kalman filter on the bus ----------------------
+
+
+@pytree_dataclass
+class FilterParams:
+    """The navigation filters of one flight. attitude, position: their tunings; field_n (3,): the geomagnetic
+    model's field at the pad [T, NED] and field_gradient (3, 3) its derivative along r_n [T/m] (the reference
+    field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
+    ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
+    the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD (0:
+    from the rail; static); horizontal_only: GNSS updates of north and east only (static); barometer: the
+    barometric height update (static)."""
+
+    attitude: AttitudeTuning
+    position: PositionTuning
+    field_n: jnp.ndarray
+    field_gradient: jnp.ndarray
+    gnss_after_s: jnp.ndarray
+    pad_samples: int = static_field(default=0)
+    horizontal_only: bool = static_field(default=False)
+    barometer: bool = static_field(default=False)
+
+
+@pytree_dataclass
+class FilterState:
+    """The filters' state: t, the time of the last solution [s]; attitude, position: the estimates then (a
+    posteriori); omega_measured_b: the gyroscope's last rates [rad/s, body frame], with which the attitude is
+    propagated over the next period; on the pad (before liftoff is sensed): the sums of the accelerometer's and
+    magnetometer's samples [m/s², T, body frame] (their directions initialise TRIAD), of the barometer's [Pa] and
+    their count (their mean is the pad pressure the barometric height is measured from), the GNC ticks on the pad;
+    failed: a covariance was not finite or not positive (latched); errors: the estimation errors' totals
+    (``NavigationErrors``)."""
+
+    t: jnp.ndarray
+    attitude: AttitudeEstimate
+    position: PositionEstimate
+    omega_measured_b: Vec3
+    pad_force_b: Vec3
+    pad_field_b: Vec3
+    pad_pressure_sum: jnp.ndarray
+    pad_pressure_count: jnp.ndarray
+    pad_ticks: jnp.ndarray
+    failed: jnp.ndarray
+    errors: NavigationErrors
+
+
+@pytree_dataclass
+class NavigationErrors:
+    """The filters' errors against the truth, summed or kept over the flight for its outputs
+    (``navigation_summary``). window: the controller's active time [s] and, over it, ∫|δϑ|² dt [rad²·s], max |δϑ|
+    [rad], ∫NEES dt of the attitude filter and of the position/velocity filter [s]; ascent: from liftoff to
+    apogee, its time [s], ∫|δϑ|² dt and max |δϑ|; bias_error: |β − β̂| [rad/s] at the window's last tick;
+    position and velocity errors [m], [m/s] at the first tick after burnout and after apogee (NaN before)."""
+
+    window_time: jnp.ndarray
+    window_attitude_sq: jnp.ndarray
+    window_attitude_max: jnp.ndarray
+    window_attitude_nees: jnp.ndarray
+    window_position_nees: jnp.ndarray
+    ascent_time: jnp.ndarray
+    ascent_attitude_sq: jnp.ndarray
+    ascent_attitude_max: jnp.ndarray
+    bias_error: jnp.ndarray
+    burnout_position: jnp.ndarray
+    burnout_velocity: jnp.ndarray
+    apogee_position: jnp.ndarray
+    apogee_velocity: jnp.ndarray
+
+
+def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterState:
+    """At rest on the pad at t = 0: the attitude from the rail (``q_nb0``; replaced by TRIAD after the pad
+    samples when ``params.pad_samples``), the position ``r_n0`` [m, NED] (the CG on the rail), at rest."""
+    zero = jnp.zeros_like(q_nb0.w)
+    still = Vec3(zero, zero, zero)
+    nan = zero + jnp.nan
+    errors = NavigationErrors(zero, zero, zero, zero, zero, zero, zero, zero, nan, nan, nan, nan, nan)
+    return FilterState(zero, initial_attitude(q_nb0, params.attitude), initial_position(r_n0, params.position),
+                       still, still, still, zero, zero, zero, jnp.zeros_like(zero, dtype=bool), errors)  # fmt: skip
+
+
+def _reference_field(params: FilterParams, r_n: Vec3) -> Vec3:
+    """The model's geomagnetic field at ``r_n`` [T, NED], to first order from the pad's."""
+    g, r = params.field_gradient, (r_n.x, r_n.y, r_n.z)
+    return Vec3(*(params.field_n[i] + sum(g[i, j] * r[j] for j in range(3)) for i in range(3)))
+
+
+def _covariance_ok(state: FilterState):
+    """Both covariances finite with positive variances (a necessary condition of positive definiteness, cheap)."""
+    p = state.position
+    variances = [state.attitude.cov[i, i] for i in range(6)] + [*p.p_rr, *p.p_vv]
+    ok = functools.reduce(jnp.logical_and, [(v > 0.0) & jnp.isfinite(v) for v in variances])
+    determinants = [rr * vv - rv * rv for rr, rv, vv in zip(p.p_rr, p.p_rv, p.p_vv)]
+    return functools.reduce(jnp.logical_and, [d > 0.0 for d in determinants], ok & jnp.all(jnp.isfinite(state.attitude.cov)))
+
+
+@pytree_dataclass
+class Measurements:
+    """What the filters read at a tick, in the body frame (FRD): force_b, the accelerometer's specific force
+    [m/s²] (its sample of the previous tick), and force_fresh; omega_b, the gyroscope's rates [rad/s], and omega_valid
+    (some sample delivered); field_b, the magnetometer's field (any unit: the filter uses its direction), and
+    field_fresh; pressure, the barometer's static pressure [Pa], and pressure_fresh; gnss (6,), a GNSS fix's position
+    [m] and velocity [m/s] (NED from the pad), and gnss_fresh."""
+
+    force_b: Vec3
+    force_fresh: jnp.ndarray
+    omega_b: Vec3
+    omega_valid: jnp.ndarray
+    field_b: Vec3
+    field_fresh: jnp.ndarray
+    pressure: jnp.ndarray
+    pressure_fresh: jnp.ndarray
+    gnss: jnp.ndarray
+    gnss_fresh: jnp.ndarray
+
+
+def bus_measurements(av: Avionics, bus: Bus) -> Measurements:
+    """The bus's latest samples as the filters read them: the 3-axis sensors turned into the body frame by their
+    mountings (known to the avionics)."""
+    accel, gyro, mag = bus.accelerometer, bus.gyroscope, bus.magnetometer
+    return Measurements(
+        to_body(av.accelerometer.rotation, accel.value), accel.fresh, to_body(av.gyroscope.rotation, gyro.value),
+        gyro.valid, to_body(av.magnetometer.sensor.rotation, mag.value), mag.fresh, bus.barometer.value[0],
+        bus.barometer.fresh, bus.gnss.value, bus.gnss.fresh,
+    )  # fmt: skip
+
+
+def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, moving, idle
+                ) -> tuple[Navigation, FilterState]:  # fmt: skip
+    """The filters' solution at time t [s] from the measurements ``m``. Position and velocity are propagated from the
+    last solution with the accelerometer's sample then (rotated into NED by the attitude then, plus gravity), the
+    attitude with the gyroscope's rates then; the magnetometer updates the attitude, the GNSS (after
+    ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh. On the pad (``moving``
+    False: liftoff not yet sensed) the pad sums grow; after ``pad_samples`` ticks there TRIAD sets the attitude.
+    ``idle`` (a parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
+    solution (body rates: the gyroscope's less the estimated bias) and the new state (its ``errors`` untouched:
+    ``track_errors``)."""
+    dt = t - state.t
+    acceleration_n = state.attitude.q_nb.rotate(m.force_b) + Vec3(0.0, 0.0, G0)
+    position = propagate_position(state.position, acceleration_n, dt, params.position)
+    attitude = propagate_attitude(state.attitude, state.omega_measured_b, dt, params.attitude)
+    reference = _reference_field(params, position.r_n)
+    attitude = tree_where(m.field_fresh, magnetometer_update(attitude, m.field_b, reference, params.attitude), attitude)
+
+    on_pad = ~moving
+    pad_ticks = state.pad_ticks + on_pad
+    pad_force_b = tree_where(on_pad & m.force_fresh, state.pad_force_b + m.force_b, state.pad_force_b)
+    pad_field_b = tree_where(on_pad & m.field_fresh, state.pad_field_b + m.field_b, state.pad_field_b)
+    pad_pressure_sum = state.pad_pressure_sum + jnp.where(on_pad & m.pressure_fresh, m.pressure, 0.0)
+    pad_pressure_count = state.pad_pressure_count + (on_pad & m.pressure_fresh)
+    if params.pad_samples:
+        aligned = on_pad & (pad_ticks == params.pad_samples)
+        attitude = tree_where(aligned, initial_attitude(triad(pad_force_b, pad_field_b, reference), params.attitude),
+                              attitude)  # fmt: skip
+
+    fix = (t >= params.gnss_after_s) & m.gnss_fresh
+    fixed = gnss_update(position, Vec3(*(m.gnss[i] for i in range(3))), Vec3(*(m.gnss[3 + i] for i in range(3))),
+                        params.position, params.horizontal_only)  # fmt: skip
+    position = tree_where(fix, fixed, position)
+    if params.barometer:
+        pad_pressure = state.pad_pressure_sum / jnp.maximum(state.pad_pressure_count, 1)
+        use = m.pressure_fresh & (state.pad_pressure_count > 0) & moving
+        height = pressure_height_m(m.pressure, pad_pressure)
+        position = tree_where(use, altitude_update(position, height, params.position), position)
+
+    omega_measured_b = tree_where(m.omega_valid, m.omega_b, Vec3(0.0, 0.0, 0.0))
+    new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_pressure_sum,
+                      pad_pressure_count, pad_ticks, state.failed, state.errors)  # fmt: skip
+    failing = ~_covariance_ok(new)
+    new = tree_where(idle | state.failed | failing, dataclasses.replace(state, t=t), new)  # the last good estimates
+    new = dataclasses.replace(new, failed=state.failed | failing)
+    omega_b = new.omega_measured_b - new.attitude.bias_b
+    return Navigation(new.position.r_n, new.position.v_n, new.attitude.q_nb, omega_b), new
+
+
+def track_errors(state: FilterState, q_nb: Quat, r_n: Vec3, v_n: Vec3, bias_b: Vec3, window_dt, ascent_dt,
+                 after_burnout, after_apogee) -> FilterState:  # fmt: skip
+    """``state`` with its ``errors`` updated against the truth at its time: attitude q_nb, CG position r_n [m] and
+    velocity v_n [m/s] (NED), the gyroscope's bias bias_b [rad/s, body frame]; window_dt, ascent_dt: the period
+    [s] if it counts for the window's or the ascent's totals, else 0; after_burnout, after_apogee: those events have
+    happened (their errors are kept at the first such tick)."""
+    e, est = state.errors, state
+    attitude_error = attitude_error_b(est.attitude.q_nb, q_nb).norm()
+    position_error, velocity_error = (est.position.r_n - r_n).norm(), (est.position.v_n - v_n).norm()
+    in_window = window_dt > 0.0
+    errors = NavigationErrors(
+        e.window_time + window_dt,
+        e.window_attitude_sq + attitude_error**2 * window_dt,
+        jnp.where(in_window, jnp.maximum(e.window_attitude_max, attitude_error), e.window_attitude_max),
+        e.window_attitude_nees + attitude_nees(est.attitude, q_nb, bias_b) * window_dt,
+        e.window_position_nees + position_nees(est.position, r_n, v_n) * window_dt,
+        e.ascent_time + ascent_dt,
+        e.ascent_attitude_sq + attitude_error**2 * ascent_dt,
+        jnp.where(ascent_dt > 0.0, jnp.maximum(e.ascent_attitude_max, attitude_error), e.ascent_attitude_max),
+        jnp.where(in_window, (est.attitude.bias_b - bias_b).norm(), e.bias_error),
+        jnp.where(after_burnout & jnp.isnan(e.burnout_position), position_error, e.burnout_position),
+        jnp.where(after_burnout & jnp.isnan(e.burnout_velocity), velocity_error, e.burnout_velocity),
+        jnp.where(after_apogee & jnp.isnan(e.apogee_position), position_error, e.apogee_position),
+        jnp.where(after_apogee & jnp.isnan(e.apogee_velocity), velocity_error, e.apogee_velocity),
+    )
+    return dataclasses.replace(state, errors=errors)
+
+
+def navigation_summary(state: FilterState) -> dict:
+    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came."""
+    e = state.errors
+
+    def mean(total, time):
+        return jnp.where(time > 0.0, total / jnp.where(time > 0.0, time, 1.0), jnp.nan)
+
+    return {
+        "attitude_error_rms_window_rad": jnp.sqrt(mean(e.window_attitude_sq, e.window_time)),
+        "attitude_error_max_window_rad": jnp.where(e.window_time > 0.0, e.window_attitude_max, jnp.nan),
+        "attitude_error_rms_ascent_rad": jnp.sqrt(mean(e.ascent_attitude_sq, e.ascent_time)),
+        "attitude_error_max_ascent_rad": jnp.where(e.ascent_time > 0.0, e.ascent_attitude_max, jnp.nan),
+        "gyro_bias_error_window_end_rad_s": e.bias_error,
+        "position_error_burnout_m": e.burnout_position,
+        "velocity_error_burnout_mps": e.burnout_velocity,
+        "position_error_apogee_m": e.apogee_position,
+        "velocity_error_apogee_mps": e.apogee_velocity,
+        "attitude_nees_window": mean(e.window_attitude_nees, e.window_time),
+        "position_nees_window": mean(e.window_position_nees, e.window_time),
+    }

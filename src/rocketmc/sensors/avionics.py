@@ -209,3 +209,15 @@ def sense_acceleration(av: Avionics, state: AvionicsState, tick, specific_force:
                                    _apply(accel.rotation, specific_force), noise, enabled, qbar)  # fmt: skip
     bus = Bus(reading, *(getattr(state.bus, name) for name in SENSORS[1:]))
     return AvionicsState({**state.channels, "accelerometer": channel_state}, bus, qbar)
+
+
+def gyroscope_bias_b(av: Avionics, state: AvionicsState) -> Vec3:
+    """The gyroscope's true bias now [rad/s, body frame]: its constant bias and its walk (the truth the navigation
+    filters' estimate is scored against; scale-factor and cross-axis errors left out)."""
+    gyro = av.gyroscope
+    return to_body(gyro.rotation, gyro.channel.bias + state.channels["gyroscope"].walk)
+
+
+def to_body(rotation, value) -> Vec3:
+    """A sensor-frame (3,) value in the body frame: the mounting rotation (body → sensor) transposed."""
+    return Vec3(*(sum(rotation[j, i] * value[j] for j in range(3)) for i in range(3)))

@@ -25,9 +25,14 @@ from ..env import (
 )  # fmt: skip
 from ..env.atmosphere import MAX_ALTITUDE_M
 from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, truth
-from ..gnc.navigation import dead_reckoning, liftoff_sensed
+from ..gnc.guidance import guidance_active
+from ..gnc.navigation import (
+    bus_measurements, dead_reckoning, filter_step, liftoff_sensed, navigation_summary, track_errors,
+)  # fmt: skip
 from ..math import Quat, Vec3, rk4_step
-from ..sensors.avionics import AvionicsState, avionics_noise, initial_avionics, sense, sense_acceleration, specific_force_b
+from ..sensors.avionics import (
+    AvionicsState, avionics_noise, gyroscope_bias_b, initial_avionics, sense, sense_acceleration, specific_force_b,
+)  # fmt: skip
 from ..pytree import pytree_dataclass, tree_where
 from .params import FlightParams, SimSettings
 
@@ -44,6 +49,7 @@ class Status(enum.IntEnum):
     MAX_TIME = 2
     OUTSIDE_AERO_TABLES = 3
     OUTSIDE_ATMOSPHERE = 4
+    NAVIGATION_FAILED = 5
 
     @property
     def message(self) -> str:
@@ -58,6 +64,9 @@ class Status(enum.IntEnum):
             Status.OUTSIDE_ATMOSPHERE: (
                 f"climbed above the standard atmosphere's top ({MAX_ALTITUDE_M / 1000:.1f} km above sea level), "
                 "where the air was held at its value there"
+            ),
+            Status.NAVIGATION_FAILED: (
+                "a navigation filter's covariance became non-finite or non-positive; its last good estimate was held"
             ),
         }[self]
 
@@ -281,7 +290,7 @@ def initial_state(p: FlightParams) -> FlightState:
     )  # fmt: skip
     turbulence = p.environment.turbulence
     filters = None if turbulence is None else initial_turbulence(turbulence)
-    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero, p.launch.q_nb0)
+    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero, p.launch.q_nb0, body.r_n)
     avionics = None if p.avionics is None else initial_avionics(p.avionics, zero)
     return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters, gnc, avionics)
 
@@ -394,21 +403,39 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     servo_params, t0 = p.gnc.servo, state.t
     state = start = _sensed(p, state, state.gnc.servo.deflection_rad, sensing, noise)
     canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in state.events.chute_trigger_times], False)
-    if p.gnc.navigation == "sensors":
-        bus = state.avionics.bus
-        nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
-        moving = liftoff_sensed(p.avionics, bus)
-        state = dataclasses.replace(state, gnc=dataclasses.replace(state.gnc, navigation=navigation))
-    else:
+    if p.gnc.navigation == "truth":
         nav, moving = truth(state.body)
+    else:
+        bus = state.avionics.bus
+        moving = liftoff_sensed(p.avionics, bus) | jnp.isfinite(state.gnc.liftoff_time)  # latched: after burnout it reads < 2 g
+        if p.gnc.navigation == "sensors":
+            nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
+        else:
+            measured = bus_measurements(p.avionics, bus)
+            nav, navigation = filter_step(p.gnc.filters, state.gnc.navigation, measured, t0, moving, canopy)
+        state = dataclasses.replace(state, gnc=dataclasses.replace(state.gnc, navigation=navigation))
     altitude_msl = p.environment.site_altitude_m - nav.r_n.z
     gnc = gnc_step(p.gnc, state.gnc, nav, moving, t0, settings.control_dt_s, altitude_msl, canopy)
+    if p.gnc.navigation == "filters":
+        gnc = dataclasses.replace(gnc, navigation=_tracked(p, settings, state, gnc, canopy))
     servo = end_of_period(servo_params, gnc.servo, period)
     state, first = control_step(p, settings, start_n, state, period,
                                 lambda t: deflection_at(servo_params, gnc.servo, t - t0), noise.turbulence,
                                 p.avionics is not None)  # fmt: skip
     state = dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
     return _accelerometer(p, start, state, first, sensing, noise)
+
+
+def _tracked(p: FlightParams, settings: SimSettings, state: FlightState, gnc: GncState, canopy):
+    """The filters' state of ``gnc`` with its errors against the truth of ``state`` at the period start (``track_errors``):
+    the window is the controller's active time (the guidance window from the sensed liftoff, no parachute), the
+    ascent from the true first motion to apogee."""
+    body, events, dt = state.body, state.events, settings.control_dt_s
+    window = guidance_active(p.gnc.guidance, state.t - gnc.liftoff_time) & ~canopy
+    ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
+    return track_errors(gnc.navigation, body.q_nb, body.r_n, body.v_n, gyroscope_bias_b(p.avionics, state.avionics),
+                        jnp.where(window, dt, 0.0), jnp.where(ascent, dt, 0.0), state.t >= events.burnout_time,
+                        state.t >= events.apogee_time)  # fmt: skip
 
 
 def _at_rest_once_landed(state: FlightState) -> RigidBodyState:
@@ -556,13 +583,30 @@ CONTROL_METRICS: dict[str, Metric] = {
 }
 """The outputs a flight with a controller adds (``gnc.control.control_summary``); NaN where it never acted."""
 
+NAVIGATION_METRICS: dict[str, Metric] = {
+    "attitude_error_rms_window_rad": Metric("rad", "RMS over the controller's active time of the attitude estimate's error angle"),
+    "attitude_error_max_window_rad": Metric("rad", "largest attitude estimation error over the controller's active time"),
+    "attitude_error_rms_ascent_rad": Metric("rad", "RMS of the attitude estimation error from the first motion to apogee"),
+    "attitude_error_max_ascent_rad": Metric("rad", "largest attitude estimation error from the first motion to apogee"),
+    "gyro_bias_error_window_end_rad_s": Metric("rad/s", "norm of the gyro-bias estimate's error at the controller's last active tick"),
+    "position_error_burnout_m": Metric("m", "norm of the position estimate's error at the first GNC tick after burnout"),
+    "velocity_error_burnout_mps": Metric("m/s", "norm of the velocity estimate's error at the first GNC tick after burnout"),
+    "position_error_apogee_m": Metric("m", "norm of the position estimate's error at the first GNC tick after apogee"),
+    "velocity_error_apogee_mps": Metric("m/s", "norm of the velocity estimate's error at the first GNC tick after apogee"),
+    "attitude_nees_window": Metric("1", "mean over the controller's active time of the MEKF's normalised estimation error squared (6 dof)"),
+    "position_nees_window": Metric("1", "mean over the controller's active time of the position/velocity filter's NEES (6 dof)"),
+}  # fmt: skip
+"""The outputs a flight on the navigation filters adds (``gnc.navigation.navigation_summary``); NaN where their span
+never came."""
+
 DEPLOY_TIME_SUFFIX = "_deploy_time_s"
 
 
 def metric(name: str) -> Metric:
     """The ``Metric`` of output ``name``: from ``METRICS`` or a parachute's ``<name>_deploy_time_s``."""
-    if name in METRICS or name in CONTROL_METRICS:
-        return {**METRICS, **CONTROL_METRICS}[name]
+    every = {**METRICS, **CONTROL_METRICS, **NAVIGATION_METRICS}
+    if name in every:
+        return every[name]
     if not name.endswith(DEPLOY_TIME_SUFFIX):
         raise KeyError(name)
     chute = name.removesuffix(DEPLOY_TIME_SUFFIX)
@@ -597,13 +641,18 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
     }
     for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
         summary[chute.name + DEPLOY_TIME_SUFFIX] = when(trigger_time, trigger_time + chute.delay_s)
+    failed = []
     if state.gnc is not None:
         summary.update(control_summary(state.gnc))
+    if p.gnc is not None and p.gnc.navigation == "filters":
+        summary.update(navigation_summary(state.gnc.navigation))
+        failed = [state.gnc.navigation.failed]
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
     status = jnp.select(
-        [ev.non_finite, ~landed, too_high, outside],
-        [Status.NON_FINITE, Status.MAX_TIME, Status.OUTSIDE_ATMOSPHERE, Status.OUTSIDE_AERO_TABLES],
+        [*failed, ev.non_finite, ~landed, too_high, outside],
+        [*[Status.NAVIGATION_FAILED] * len(failed), Status.NON_FINITE, Status.MAX_TIME, Status.OUTSIDE_ATMOSPHERE,
+         Status.OUTSIDE_AERO_TABLES],
         Status.OK,
-    )
+    )  # fmt: skip
     return summary, status.astype(jnp.int32)
