@@ -508,6 +508,8 @@ def test_gnc_needs_four_canards():
          "whole campaign (guidance, the LQI gains and the navigation filters are set once, when it loads); only the servos"),
         ("gnc.guidance.window_start_s", {"dist": "uniform", "low": 1.0, "high": 3.5},
          "dispersions.gnc.guidance.window_start_s: fixed for the whole campaign"),
+        ("gnc.filters.attitude.field_direction_std", {"dist": "normal", "std": 0.5},
+         "dispersions.gnc.filters.attitude.field_direction_std: fixed for the whole campaign"),
         ("gnc.servo.limit_deg", {"dist": "normal", "std": 2.0}, "dispersions.gnc.servo.limit_deg: draws a value -2.0 "
          "(mean − 6·std; clip it with low) that is out of range: gnc.servo.limit_deg: Input should be greater than 0"),
         ("gnc.servo.offset_deg.2", {"dist": "uniform", "low": -12.0, "high": 0.0},
