@@ -21,7 +21,7 @@ from jax.extend.random import threefry2x32_p
 
 from ..env.atmosphere import G0, isa
 from ..math import Quat, Vec3
-from ..pytree import pytree_dataclass
+from ..pytree import pytree_dataclass, static_field
 from .errors import Channel, ChannelState, initial_channel, sample
 from .parts import SENSORS
 
@@ -100,12 +100,27 @@ class Avionics:
 
 @pytree_dataclass
 class AvionicsState:
-    """Each sensor's error state (``errors.ChannelState``, by name), the bus, and the dynamic pressure at the
-    last accelerometer sample [Pa] (the vibration of the sensors sampled at the next tick)."""
+    """The sensors' state as a few stacked arrays (each leaf of the flight loop's state costs kernels of its own
+    every period): values (k,), each sensor's latest delivered sample in the bus's order (``sizes`` [i] values
+    each, none for an absent sensor); fresh, valid (6,), its ``Reading`` flags; walks (w,), the random walks β
+    of the channels that have one, in the bus's order; queues: each delayed channel's samples not yet
+    delivered (``errors.ChannelState``'s queue and queued), by name; qbar: the dynamic pressure at the last
+    accelerometer sample [Pa] (the vibration of the sensors sampled at the next tick). ``bus``: the ``Bus``."""
 
-    channels: dict
-    bus: Bus
+    values: jnp.ndarray
+    fresh: jnp.ndarray
+    valid: jnp.ndarray
+    walks: jnp.ndarray
+    queues: dict
     qbar: jnp.ndarray
+    sizes: tuple = static_field(default=())
+
+    @property
+    def bus(self) -> Bus:
+        """Every sensor's ``Reading``: slices of the stacked arrays."""
+        ends = np.cumsum(self.sizes)
+        return Bus(*(Reading(self.values[end - n : end], self.fresh[i], self.valid[i])
+                     for i, (n, end) in enumerate(zip(self.sizes, ends))))  # fmt: skip
 
 
 def channels(av: Avionics) -> dict[str, Channel]:
@@ -119,11 +134,22 @@ def channels(av: Avionics) -> dict[str, Channel]:
 def initial_avionics(av: Avionics, like) -> AvionicsState:
     """Nothing sampled yet (an absent sensor's reading empty for good); ``like``: a scalar of the flight's dtype."""
     present = channels(av)
-    state = {name: initial_channel(c, like) for name, c in present.items()}
-    no = jnp.zeros((), bool)
-    sizes = [present[name].n if name in present else 0 for name in SENSORS]
-    bus = Bus(*(Reading(jnp.zeros(n, jnp.result_type(like)), no, no) for n in sizes))
-    return AvionicsState(state, bus, jnp.zeros_like(like))
+    dtype = jnp.result_type(like)
+    sizes = tuple(present[name].n if name in present else 0 for name in SENSORS)
+    no = jnp.zeros(len(SENSORS), bool)
+    walks = sum(c.n for c in present.values() if c.walk_std is not None)
+    queues = {name: initial_channel(c, like) for name, c in present.items() if c.delay}
+    return AvionicsState(jnp.zeros(sum(sizes), dtype), no, no, jnp.zeros(walks, dtype),
+                         {name: (q.queue, q.queued) for name, q in queues.items()}, jnp.zeros_like(like), sizes)  # fmt: skip
+
+
+def _walk_slices(av: Avionics) -> dict[str, slice]:
+    """Each walking channel's slice of ``AvionicsState.walks``, by name."""
+    slices, start = {}, 0
+    for name, c in channels(av).items():
+        if c.walk_std is not None:
+            slices[name], start = slice(start, start + c.n), start + c.n
+    return slices
 
 
 def noise_columns(av: Avionics) -> dict[str, slice]:
@@ -192,14 +218,30 @@ def _apply(matrix, v: Vec3):
     return jnp.stack([matrix[i, 0] * v.x + matrix[i, 1] * v.y + matrix[i, 2] * v.z for i in range(3)])
 
 
-def _read(av: Avionics, av_channel: Channel, state: AvionicsState, name: str, tick, truth, noise, enabled, qbar=0.0):
-    """(the new Reading, the new ChannelState) of sensor ``name`` at ``tick``; noise: the tick's row of
-    ``avionics_noise``; qbar: the dynamic pressure [Pa] (vibration)."""
-    columns = noise_columns(av)
+def _read(av: Avionics, channel: Channel, state: AvionicsState, name: str, tick, truth, noise, enabled, qbar=0.0):
+    """(delivered, fresh, new ``ChannelState``) of sensor ``name`` at ``tick`` (``errors.sample``); noise: the
+    tick's row of ``avionics_noise``; qbar: the dynamic pressure [Pa] (vibration)."""
+    columns, walks = noise_columns(av), _walk_slices(av)
     own = noise[columns[name]] if name in columns else None
-    value, fresh, channel_state = sample(av_channel, state.channels[name], tick, truth, own, enabled, qbar)
-    old = getattr(state.bus, name)
-    return Reading(jnp.where(fresh, value, old.value), fresh, old.valid | fresh), channel_state
+    walk = state.walks[walks[name]] if name in walks else jnp.zeros(channel.n, state.walks.dtype)
+    queue, queued = state.queues.get(name, (jnp.zeros((0, channel.n), walk.dtype), jnp.zeros(0, bool)))
+    return sample(channel, ChannelState(walk, queue, queued), tick, truth, own, enabled, qbar)
+
+
+def _written(av: Avionics, state: AvionicsState, read: dict, qbar) -> AvionicsState:
+    """``state`` with the samples ``read`` ({name: ``_read``'s}) on the bus, each stacked array written at once."""
+    ends = np.cumsum(state.sizes)
+    values, fresh = [], []
+    for i, (name, n, end) in enumerate(zip(SENSORS, state.sizes, ends)):
+        old = state.values[end - n : end]
+        values.append(jnp.where(read[name][1], read[name][0], old) if name in read else old)
+        fresh.append(read[name][1] if name in read else state.fresh[i])
+    fresh = jnp.stack(fresh)
+    walks = [read[name][2].walk if name in read else state.walks[s] for name, s in _walk_slices(av).items()]
+    queues = {name: (read[name][2].queue, read[name][2].queued) if name in read else q
+              for name, q in state.queues.items()}  # fmt: skip
+    return AvionicsState(jnp.concatenate(values), fresh, state.valid | fresh,
+                         jnp.concatenate(walks) if walks else state.walks, queues, qbar, state.sizes)  # fmt: skip
 
 
 def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_nb: Quat, omega_b: Vec3,
@@ -222,14 +264,13 @@ def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_n
         "gnss": (gnss.channel, fix),
         "canard_feedback": (av.canard_feedback, deflections),
     }  # fmt: skip
-    readings, channel_states = {"canard_feedback": state.bus.canard_feedback}, dict(state.channels)
+    read = {}
     for name, (channel, truth) in truths.items():
         if channel is None:
             continue
         gate = enabled & (t >= gnss.first_fix_s) if name == "gnss" else enabled
-        readings[name], channel_states[name] = _read(av, channel, state, name, tick, truth, noise, gate, state.qbar)
-    bus = Bus(state.bus.accelerometer, **readings)
-    return AvionicsState(channel_states, bus, state.qbar)
+        read[name] = _read(av, channel, state, name, tick, truth, noise, gate, state.qbar)
+    return _written(av, state, read, state.qbar)
 
 
 def specific_force_b(acceleration_n: Vec3, q_nb: Quat, omega_b: Vec3, omega_dot_b: Vec3, arm_b: Vec3) -> Vec3:
@@ -243,7 +284,6 @@ def sense_acceleration(av: Avionics, state: AvionicsState, tick, specific_force:
     """The accelerometer's sample of tick ``tick`` from the specific force at its position [m/s², body frame] and
     the dynamic pressure [Pa] then (the airframe's vibration)."""
     accel = av.accelerometer
-    reading, channel_state = _read(av, accel.channel, state, "accelerometer", tick,
-                                   _apply(accel.rotation, specific_force), noise, enabled, qbar)  # fmt: skip
-    bus = Bus(reading, *(getattr(state.bus, name) for name in SENSORS[1:]))
-    return AvionicsState({**state.channels, "accelerometer": channel_state}, bus, qbar)
+    read = _read(av, accel.channel, state, "accelerometer", tick, _apply(accel.rotation, specific_force), noise,
+                 enabled, qbar)  # fmt: skip
+    return _written(av, state, {"accelerometer": read}, qbar)
