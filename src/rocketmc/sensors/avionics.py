@@ -198,7 +198,9 @@ def normals(keys, widths, samples):
     shape = (s.shape[0], len(pairs))
     hi = jnp.broadcast_to(s >> np.uint32(24), shape)
     lo = (s << np.uint32(8)) | np.array([j for _, j in pairs], np.uint32)
-    k1, k2 = (jnp.broadcast_to(jnp.stack([data[i][half] for i, _ in pairs]), shape) for half in (0, 1))
+    # keys (1, pairs), not broadcast to the block: XLA's rolled threefry loop carries (and copies) its key schedule
+    # at their shape (the draws 1.5x faster standalone, measured)
+    k1, k2 = (jnp.stack([data[i][half] for i, _ in pairs])[None] for half in (0, 1))
     words = jnp.concatenate(threefry2x32_p.bind(k1, k2, hi, lo), axis=1)
     # stream i's w columns: the first words of its h = ⌈w/2⌉ pairs, then their second words (w odd: one unused)
     start, column = 0, []
