@@ -124,9 +124,12 @@ def test_replayed_navigation_tracks_the_truth(flight):
     nav = replay.replay(flight["log"], params, q_nb0, flight["campaign"].config.site)  # r_n0: the first GNSS fix
     truth = flight["truth"]
     height_error = nav["height_m"] - (-(truth.r_n.z - truth.r_n.z[0]))
-    # 4 m: the thesis barometer's 50 Pa per sample is ~5 m near the pad (its 300 Pa bias cancels against the pad
-    # pressure it also reads), which the filter averages down (measured 1.8 m); a timing or pad-pressure slip is tens
-    assert np.sqrt(np.mean(height_error**2)) < 4.0
+    # 15 m: the pad pressure is the mean of the one or two barometer samples before liftoff is sensed (50 Pa each:
+    # 3-4 m of height per σ, for the whole flight), and the barometer's 300 Pa bias, which the pad pressure cancels at
+    # the pad, reads ~5 m more height 1.5 km up (the ISA's dh/dp grows as the air thins); measured 9.4 m (-5.3 m
+    # from this draw's pad pressure, -11 m at apogee), 1.8 m with another draw; a timing or pad-pressure slip is
+    # tens to hundreds of metres
+    assert np.sqrt(np.mean(height_error**2)) < 15.0
     speed_error = np.linalg.norm(np.column_stack([nav[f"v_{d}_mps"] - truth.v_n[i]
                                                   for i, d in enumerate(("north", "east", "down"))]), axis=1)  # fmt: skip
     # 0.5 m/s: the GNSS velocity's standard deviation as tuned (GNSS_STD; the receiver's own is 0.04-0.08 m/s,

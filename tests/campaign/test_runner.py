@@ -57,10 +57,10 @@ def test_same_bits_for_any_chunk_size(name, sensors):
     a_out, a_in = collect(campaign, 5)
     b_out, b_in = collect(campaign, 20)
     assert a_out.keys() == b_out.keys() and a_in.keys() == b_in.keys()
-    for name in a_out:
-        np.testing.assert_array_equal(a_out[name], b_out[name], err_msg=name)  # bit-identical (NaNs equal)
-    for name in a_in:
-        np.testing.assert_array_equal(a_in[name], b_in[name], err_msg=name)
+    for output in a_out:
+        np.testing.assert_array_equal(a_out[output], b_out[output], err_msg=output)  # bit-identical (NaNs equal)
+    for value in a_in:
+        np.testing.assert_array_equal(a_in[value], b_in[value], err_msg=value)
     assert np.all(a_out["status"] == 0)
     assert len(np.unique(a_out["impact_north_m"])) == 24  # the realizations do differ
     if closed_loop:
