@@ -407,7 +407,8 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
         nav, moving = truth(state.body)
     else:
         bus = state.avionics.bus
-        moving = liftoff_sensed(p.avionics, bus) | jnp.isfinite(state.gnc.liftoff_time)  # latched: after burnout it reads < 2 g
+        # liftoff latched: after burnout the accelerometer reads less than the 2 g that sensed it
+        moving = liftoff_sensed(p.avionics, bus) | jnp.isfinite(state.gnc.liftoff_time)
         if p.gnc.navigation == "sensors":
             nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
         else:
@@ -427,9 +428,9 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
 
 
 def _tracked(p: FlightParams, settings: SimSettings, state: FlightState, gnc: GncState, canopy):
-    """The filters' state of ``gnc`` with its errors against the truth of ``state`` at the period start (``track_errors``):
-    the window is the controller's active time (the guidance window from the sensed liftoff, no parachute), the
-    ascent from the true first motion to apogee."""
+    """The filters' state of ``gnc`` with its errors against the truth of ``state`` at the period start
+    (``track_errors``): the window is the controller's active time (the guidance window from the sensed liftoff, no
+    parachute), the ascent from the true first motion to apogee."""
     body, events, dt = state.body, state.events, settings.control_dt_s
     window = guidance_active(p.gnc.guidance, state.t - gnc.liftoff_time) & ~canopy
     ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
