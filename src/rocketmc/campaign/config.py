@@ -577,7 +577,8 @@ class PositionFilterConfig(_Strict):
     gnss_position_std_m: list[StdDeviation] = Field([500.0, 500.0, 700.0], min_length=3, max_length=3)
     gnss_velocity_std_mps: list[StdDeviation] = Field([50.0, 50.0, 70.0], min_length=3, max_length=3)
     barometer: bool = False
-    altitude_std_m: StdDeviation = 5.0
+    altitude_std_m: StdDeviation = 5.0  # GNC.md's MS5803-class 50 Pa per sample over ρ·g: 4.2 m at sea level, 4.8 m at
+    # Lynx's 1.4 km pads (the thesis has no barometer update)
     initial_position_std_m: StdDeviation = 1.0
     initial_velocity_std_mps: StdDeviation = 1.0
 

@@ -39,8 +39,8 @@ class PositionTuning:
 
     position_noise: σ_r, process-noise density on the position [m/√s] (Q_r = T σ_r²); velocity_noise: σ_v, on the
     velocity [m/s/√s] (Q_v = T σ_v²); gnss_position_std, gnss_velocity_std: GNSS measurement noise per axis N, E,
-    D [m], [m/s]; altitude_std: barometric altitude noise [m] (the thesis has no barometer: the default is
-    GNC.md's MS5803-class σ of 50 Pa over ρ0 g0 = 12.0 Pa/m at sea level); initial_position_std,
+    D [m], [m/s]; altitude_std: barometric altitude noise [m] (the thesis has no barometer: the default is the
+    campaign's, ``PositionFilterConfig.altitude_std_m``); initial_position_std,
     initial_velocity_std: the square roots of P0's diagonal [m], [m/s].
     """
 
@@ -48,7 +48,7 @@ class PositionTuning:
     velocity_noise: jnp.ndarray = 1.0
     gnss_position_std: Vec3 = Vec3(500.0, 500.0, 700.0)
     gnss_velocity_std: Vec3 = Vec3(50.0, 50.0, 70.0)
-    altitude_std: jnp.ndarray = 4.2
+    altitude_std: jnp.ndarray = 5.0
     initial_position_std: jnp.ndarray = 1.0
     initial_velocity_std: jnp.ndarray = 1.0
 
