@@ -17,7 +17,7 @@ install: $(VENV)/.installed
 
 demo: install
 	mkdir -p results
-	$(VENV)/bin/rocketmc run campaigns/lynx_nominal.toml -n $(N) --out results/lynx_nominal.h5
+	$(VENV)/bin/rocketmc run campaigns/lynx_nominal.toml -n $(N) --out results/lynx_nominal.h5 --force  # the demo is meant to be rerun
 	$(VENV)/bin/rocketmc report results/lynx_nominal.h5 --plot results/lynx_nominal_ellipses.png
 
 test: install  # timing tests (-m performance) alone, after the parallel ones

@@ -184,3 +184,38 @@ def test_validate_plots_into_a_file(tmp_path, capsys):
     (tmp_path / "a_file").write_text("")
     """Refused before the flight is flown."""
     one_line(capsys, ["validate", "roccaraso-2021", "--plot", str(tmp_path / "a_file" / "plots")], "a_file")
+
+
+# --- data files are never overwritten without --force (issue 19, part 4.1) -----------------------
+
+def test_run_refuses_an_existing_result_file(tmp_path, capsys):
+    """An existing --out is kept byte for byte; the line names it and the two ways on."""
+    out = write_result(tmp_path / "x.h5")
+    before = out.read_bytes()
+    one_line(capsys, ["run", str(CAMPAIGNS / "lynx_ballistic.toml"), "--out", str(out)], "--out", str(out),
+             "exists", "--resume", "--force")  # fmt: skip
+    assert out.read_bytes() == before and files_in(tmp_path) == ["x.h5"]
+
+
+def test_run_resume_and_force_are_exclusive(tmp_path, capsys):
+    one_line(capsys, ["run", str(CAMPAIGNS / "lynx_ballistic.toml"), "--resume", "--force"], "--force", "--resume")
+
+
+def test_report_refuses_an_existing_map_unless_forced(result, tmp_path, capsys):
+    kml = tmp_path / "impacts.kml"
+    kml.write_text("mine")
+    one_line(capsys, ["report", str(result), "--map", str(kml)], "--map", "exists", "--force")
+    assert kml.read_text() == "mine"
+    assert main(["report", str(result), "--map", str(kml), "--force"]) == 0
+    assert "<kml" in kml.read_text()
+
+
+def test_navigate_and_sensors_refuse_existing_data_files(tmp_path, capsys):
+    nav = tmp_path / "nav.csv"
+    nav.write_text("mine")
+    one_line(capsys, ["navigate", str(tmp_path), "--out", str(nav)], "--out", "exists", "--force")
+    (tmp_path / "log").mkdir()
+    (tmp_path / "log" / "baro_ms5803_66hz.csv").write_text("mine")
+    one_line(capsys, ["sensors", "simulate", str(CAMPAIGNS / "lynx_nominal.toml"), "--out", str(tmp_path / "log")],
+             "--out", "baro_ms5803_66hz.csv", "exists", "--force")  # fmt: skip
+    assert nav.read_text() == "mine" and (tmp_path / "log" / "baro_ms5803_66hz.csv").read_text() == "mine"

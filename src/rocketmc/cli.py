@@ -51,6 +51,8 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
 
     cfg = campaign.config
     out = Path(args.out or f"{file_stem(cfg.name)}.h5")
+    if out.is_file() and not (args.resume or args.force):
+        raise RocketmcError(f"--out {out}: the file exists; use --resume to continue it or --force to replace it")
     chunk_size, n_chunks = chunking(campaign, args.chunk_size)
     writer = ResultWriter(out, campaign, chunk_size, resume=args.resume)
     if writer.already_complete:
@@ -114,7 +116,7 @@ def _report(args) -> int:
     from .analysis.export import MAP_SUFFIXES, write_map
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
-    maps = [_output_file("--map", path, MAP_SUFFIXES) for path in args.map or []]
+    maps = [_refuse_existing("--map", _output_file("--map", path, MAP_SUFFIXES), args.force) for path in args.map or []]
     run = load_run(args.file)
     summary = summarize(run)
     print(json.dumps(summary, indent=2, allow_nan=False) if args.json else format_summary(summary))
@@ -161,6 +163,14 @@ def _output_file(option: str, path: str, suffixes: tuple[str, ...]) -> Path:
         raise RocketmcError(f"{option} {path}: no folder {folder} to write it in")
     if not os.access(folder, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
         raise RocketmcError(f"{option} {path}: not writable (read-only folder or file)")
+    return path
+
+
+def _refuse_existing(option: str, path: Path, force: bool) -> Path:
+    """``path``, unless a data file is there already and ``force`` is off: then a one-line RocketmcError
+    (figures are redrawn in place; data files are replaced only with ``--force``)."""
+    if path.exists() and not force:
+        raise RocketmcError(f"{option} {path}: the file exists; use --force to replace it")
     return path
 
 
@@ -278,6 +288,8 @@ def _sensors_simulate(args) -> int:
     from .analysis.sensor_log import LOG_FILES, write_sensor_log
     from .campaign.sensor_record import sensor_record
 
+    for file, _ in LOG_FILES.values():
+        _refuse_existing("--out", Path(args.out) / file, args.force)
     campaign = _campaign(args.campaign)
     logs = sensor_record(campaign, args.realization, args.static,
                          log=lambda line: None if args.quiet else print(line, file=sys.stderr))  # fmt: skip
@@ -307,7 +319,7 @@ def _navigate(args) -> int:
     from .campaign.model import filter_params
     from .files import replacing
 
-    out = None if args.out is None else _output_file("--out", args.out, (".csv",))
+    out = None if args.out is None else _refuse_existing("--out", _output_file("--out", args.out, (".csv",)), args.force)
     campaign = _site_campaign(args.site)
     config = campaign.config
     if (FiltersConfig() if config.gnc is None else config.gnc.filters).initialisation == "pad":
@@ -432,7 +444,9 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--until-converged", type=float, metavar="PCT",
                      help="add chunks (up to N) until the 95 %% ellipse area's 95 %% bootstrap interval is "
                           "narrower than PCT %% of the area; the file keeps the N reached")  # fmt: skip
-    run.add_argument("--resume", action="store_true",
+    replace = run.add_mutually_exclusive_group()
+    replace.add_argument("--force", action="store_true", help="replace an existing result file")
+    replace.add_argument("--resume", action="store_true",
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
     run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                      help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
@@ -453,6 +467,7 @@ def main(argv: list[str] | None = None) -> int:
     report.add_argument("file", help="HDF5 result file")
     report.add_argument("--plot", help="write the impact plot with 50/95/99 %% ellipses to this PNG")
     report.add_argument("--json", action="store_true", help="print the summary as JSON")
+    report.add_argument("--force", action="store_true", help="replace existing --map files")
     report.add_argument("--map", action="append", metavar="FILE",
                         help="write the impact points and ellipses around the launch site as KML (.kml) or "
                              "GeoJSON (.geojson); repeatable")  # fmt: skip
@@ -486,6 +501,7 @@ def main(argv: list[str] | None = None) -> int:
     simulate.add_argument("--static", type=float, metavar="SECONDS",
                           help="instead, the rocket at rest on the pad for this long (noise analysis)")  # fmt: skip
     simulate.add_argument("--out", required=True, metavar="DIR", help="folder for the CSV files")
+    simulate.add_argument("--force", action="store_true", help="replace the CSV files of a log already in --out")
     simulate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     navigate = commands.add_parser(
         "navigate", help="the navigation filters replayed on a sensor log (the real Roccaraso one or a simulated one)")
@@ -505,6 +521,7 @@ def main(argv: list[str] | None = None) -> int:
                                "(default: the campaign's)")  # fmt: skip
     navigate.add_argument("--field-direction-std", type=float, metavar="S",
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--force", action="store_true", help="replace an existing --out file")
     navigate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
