@@ -140,6 +140,31 @@ def test_absurd_magnitudes_are_refused_naming_the_field(path, value, words):
     assert message.startswith(f"{path}: ") and words in message, message
 
 
+@pytest.mark.parametrize("key, value, field, words", [
+    ("fins.0.position_m", 2.2, "rocket.geometry.fins.0.position_m", "outside the body"),  # root ends 0.055 m past the tail
+    ("fins.0.position_m", -0.1, "rocket.geometry.fins.0.position_m", "outside the body"),  # ahead of the nose tip
+    ("canards.position_m", 2.4, "rocket.geometry.canards.position_m", "outside the body"),
+    ("canards.position_m", 2.0, "rocket.geometry.canards.position_m", "overlaps fins.0"),  # 2.0-2.15 against 2.145-2.495
+    ("boat_tail", {"length_m": 0.1, "aft_diameter_m": 0.1, "position_m": 2.45}, "rocket.geometry.boat_tail.position_m",
+     "aft end"),
+    ("boat_tail", {"length_m": 0.1, "aft_diameter_m": 0.2, "position_m": 2.395}, "rocket.geometry.boat_tail.aft_diameter_m",
+     "narrows"),
+])  # fmt: skip
+def test_geometry_that_cannot_be_built(key, value, field, words):
+    """A fin set past the tail or ahead of the nose, canards outside the body or over the fins, a boat-tail past
+    the aft end or widening: one line naming the field, before any table is built."""
+    message = refusal(replaced(EXPANDED, f"rocket.geometry.{key}", value))
+    assert message.startswith(f"{field}: ") and words in message, message
+
+
+def test_geometry_that_just_fits_is_accepted():
+    """The limits are inclusive: a fin set ending at the aft end, canards touching it, a boat-tail ending there."""
+    raw = replaced(EXPANDED, "rocket.geometry.fins.0.position_m", 2.145)
+    raw = replaced(raw, "rocket.geometry.canards.position_m", 2.145 - 0.15)
+    raw = replaced(raw, "rocket.geometry.boat_tail", {"length_m": 0.1, "aft_diameter_m": 0.12, "position_m": 2.395})
+    campaign_from_dict(raw, CAMPAIGNS)
+
+
 def test_geometry_and_power_law_consistency():
     """A nose longer than the rocket (it divided by zero in the build-up) and a power-law reference
     height below the 1 m the law is held at (the stated speed would never be flown) are refused."""

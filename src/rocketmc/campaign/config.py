@@ -1051,6 +1051,7 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
             raise ConfigError(f"rocket.preset: expected a string (got {rocket['preset']!r})")
         raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"]), overrides)
     config = _validate(raw)
+    _check_geometry(config.rocket)
 
     path = _resolve_data_file(config.rocket.motor.thrust_curve, base_dir, "motors", "rocket.motor.thrust_curve")
     try:
@@ -1094,6 +1095,46 @@ def sample_period_ticks(config: CampaignConfig, sensor: str) -> int:
                           f"simulation.control_dt_s = {dt:g} s) into a divisor of {SimSettings.block_steps} GNC "
                           f"periods (the noise blocks): e.g. {rates} Hz")  # fmt: skip
     return every
+
+
+GEOMETRY_TOLERANCE_M = 1e-9
+"""Slack on the geometry's fits [m]: a fin whose trailing edge is the aft end, computed from positions in
+another origin, may land a rounding error past it."""
+
+
+def _check_geometry(rocket: RocketConfig) -> None:
+    """The build-up's shape can be built: every fin set's and the canards' root chord on the body (from the
+    nose tip to the aft end), the canards clear of every fin set, a boat-tail behind the nose and ending at
+    or before the aft end, narrowing; one line naming the field."""
+    g = rocket.geometry
+    if g is None:
+        return
+    length, eps = g.length_m, GEOMETRY_TOLERANCE_M
+
+    def root(path: str, f: FinSetConfig) -> tuple[float, float]:
+        start = rocket.from_nose(f.position_m)
+        end = start + f.root_chord_m
+        if start < -eps or end > length + eps:
+            raise ConfigError(f"rocket.geometry.{path}.position_m: the root chord spans {start:g} to {end:g} m from "
+                              f"the nose tip, outside the body (0 to length_m = {length:g} m)")  # fmt: skip
+        return start, end
+
+    fins = [(f"fins.{i}", root(f"fins.{i}", f)) for i, f in enumerate(g.fins)]
+    if g.canards is not None:
+        start, end = root("canards", g.canards)
+        for path, (fin_start, fin_end) in fins:
+            if start < fin_end - eps and fin_start < end - eps:
+                raise ConfigError(f"rocket.geometry.canards.position_m: the canards' root chord ({start:g} to {end:g} m "
+                                  f"from the nose tip) overlaps {path}'s ({fin_start:g} to {fin_end:g} m)")  # fmt: skip
+    if (tail := g.boat_tail) is not None:
+        start = rocket.from_nose(tail.position_m)
+        if start < g.nose.length_m - eps or start + tail.length_m > length + eps:
+            raise ConfigError(f"rocket.geometry.boat_tail.position_m: the boat-tail spans {start:g} to "
+                              f"{start + tail.length_m:g} m from the nose tip, not between the nose's end "
+                              f"({g.nose.length_m:g} m) and the aft end ({length:g} m)")  # fmt: skip
+        if tail.aft_diameter_m > g.body_diameter_m:
+            raise ConfigError(f"rocket.geometry.boat_tail.aft_diameter_m: {tail.aft_diameter_m:g} m exceeds the body's "
+                              f"diameter ({g.body_diameter_m:g} m); a boat-tail narrows")  # fmt: skip
 
 
 def _check_avionics(config: CampaignConfig) -> None:
