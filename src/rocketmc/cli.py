@@ -47,6 +47,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     ``where`` describing the cluster) and write the result file."""
     from .analysis.ellipse import AreaConvergence
     from .campaign import ResultWriter
+    from .campaign.checks import stability_warnings
     from .campaign.runner import chunking
 
     cfg = campaign.config
@@ -58,6 +59,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     if writer.already_complete:
         print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
         return 0
+    _warn(stability_warnings(campaign))
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
     tty = sys.stderr.isatty() and not args.quiet
@@ -108,7 +110,29 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     writer.finish(n_rows)
     rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
     log(f"wrote {out} ({flown} flights flown in this run{rate})")
+    _warn(_validity_warnings(campaign, out))
     return 0
+
+
+def _validity_warnings(campaign, path: Path) -> list[str]:
+    """``checks.aero_validity_warnings`` of the flights in the result file ``path``."""
+    import h5py
+    import numpy as np
+
+    from .campaign.checks import aero_validity_warnings
+
+    with h5py.File(path, "r") as f:
+        outputs = {name: f[f"outputs/{name}"][()] for name in ("max_mach", "apogee_agl_m", "max_dynamic_pressure_outside_aero_tables_pa")}  # fmt: skip
+    top = lambda values: float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")  # noqa: E731
+    outside = int((outputs["max_dynamic_pressure_outside_aero_tables_pa"] > 0).sum())
+    return aero_validity_warnings(campaign, top(outputs["max_mach"]),
+                                  top(outputs["apogee_agl_m"]) + campaign.config.site.altitude_m, outside)  # fmt: skip
+
+
+def _warn(lines: list[str]) -> None:
+    """Each of ``lines`` as a ``rocketmc: warning:`` line on stderr (shown even with --quiet)."""
+    for line in lines:
+        print(f"rocketmc: warning: {' '.join(line.split())}", file=sys.stderr)
 
 
 def _report(args) -> int:
@@ -203,8 +227,9 @@ def _rocket_campaign(rocket: str):
 
 def _aero_derivatives(args) -> int:
     from .aero.model import LinearAero, linear_derivatives, simplify
+    from .aero.stability import centre_of_pressure_x_m
+    from .campaign.checks import liftoff_and_burnout_cg_x_m
     from .campaign.model import nominal_params
-    from .sim.flight import mass_properties
 
     campaign = _rocket_campaign(args.rocket)
     params = nominal_params(campaign)
@@ -215,12 +240,8 @@ def _aero_derivatives(args) -> int:
     reference_point = rocket.from_nose(rocket.reference_point_m)  # positions below: from the nose tip
     d = float(linear.reference_length_m)
     moment_reference = reference_point - float(linear.moment_ref_x_m)
-    cp = moment_reference - c["Cma"] * d / c["CNa"]
-    motor = params.rocket.motor
-    cg = {
-        when: reference_point - float(mass_properties(params, t).cg_x)
-        for when, t in (("liftoff", 0.0), ("burnout", float(motor.ignition_time_s + motor.burn_time_s)))
-    }
+    cp = reference_point - centre_of_pressure_x_m(linear, args.mach, args.altitude)
+    cg = {when: reference_point - x for when, x in liftoff_and_burnout_cg_x_m(params).items()}
     result = {
         "rocket": args.rocket,
         "model": campaign.config.rocket.aero.model,

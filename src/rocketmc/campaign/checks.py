@@ -1,0 +1,75 @@
+"""Checks of a campaign before and after flying that warn rather than refuse: a nominal rocket that is
+statically unstable (someone may fly one on purpose, to see where it lands) and flights beyond the range
+of the aerodynamic tables or of the method that built them. Each returns the warning lines (none: all is
+well), for ``run``, ``fly`` and ``report`` alike."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..aero.buildup import MAX_SUBSONIC_MACH
+from ..aero.model import LinearAero
+from ..aero.stability import static_margin_calibers
+from ..sim.flight import mass_properties
+from ..sim.params import FlightParams
+from .config import Campaign
+from .model import nominal_params
+
+MARGIN_MACH = 0.3
+"""Mach number at which the pre-flight static margin is read (the slopes' value early in the ascent)."""
+
+
+def liftoff_and_burnout_cg_x_m(params: FlightParams) -> dict[str, float]:
+    """Body-frame x of the rocket's centre of mass at liftoff (t = 0, full motor) and at burnout [m, from the
+    reference point, positive toward the nose]."""
+    motor = params.rocket.motor
+    times = {"liftoff": 0.0, "burnout": float(motor.ignition_time_s + motor.burn_time_s)}
+    return {when: float(mass_properties(params, t).cg_x) for when, t in times.items()}
+
+
+def nominal_static_margins(campaign: Campaign, mach: float = MARGIN_MACH) -> dict[str, float]:
+    """The nominal rocket's static margin [calibers] at liftoff and at burnout (``static_margin_calibers``),
+    the slopes read at ``mach`` and the pad's altitude."""
+    params = nominal_params(campaign)
+    altitude = campaign.config.site.altitude_m
+    return {when: static_margin_calibers(params.rocket.aero, x, mach, altitude)
+            for when, x in liftoff_and_burnout_cg_x_m(params).items()}  # fmt: skip
+
+
+def stability_warnings(campaign: Campaign, mach: float = MARGIN_MACH) -> list[str]:
+    """One line per instant (liftoff, burnout) at which the nominal rocket's static margin is negative (or
+    undefined: no restoring normal force)."""
+    return [
+        f"{campaign.config.name}: the nominal rocket is statically unstable at {when}: static margin {margin:.2f} "
+        f"calibers at Mach {mach:g} (centre of pressure ahead of the centre of mass)"
+        for when, margin in nominal_static_margins(campaign, mach).items()
+        if not margin >= 0
+    ]
+
+
+def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: float | None = None,
+                           outside_tables: int = 0) -> list[str]:  # fmt: skip
+    """Warning lines where flights went beyond the aerodynamic method: ``max_mach`` (the largest Mach number
+    flown) above the tables' Mach axis (values clamped at its edge) or, for built-up tables, above the
+    subsonic theory's ``MAX_SUBSONIC_MACH``; ``max_altitude_m`` [m MSL] above the tables' altitude axis;
+    ``outside_tables`` flights that flew outside any axis (α, β, Mach, altitude) at a dynamic pressure > 0
+    (``/outputs/max_dynamic_pressure_outside_aero_tables_pa``). NaN maxima (no flight ok) are skipped."""
+    aero = campaign.aero if campaign.aero is not None else nominal_params(campaign).rocket.aero
+    tables = [aero.table] if isinstance(aero, LinearAero) else [t for t in (aero.body, aero.canard_table) if t]
+    name, lines = campaign.config.name, []
+    for axis, flown, unit in (("mach", max_mach, ""), ("altitude", max_altitude_m, " m")):
+        tops = [float(np.max(t.axes[t.axis_names.index(axis)])) for t in tables if axis in t.axis_names]
+        if flown is not None and tops and flown > min(tops):
+            lines.append(f"{name}: flights reach {axis} {flown:.4g}{unit}, beyond the aerodynamic tables' "
+                         f"{min(tops):.4g}{unit} (coefficients held at the edge)")  # fmt: skip
+    rocket = campaign.config.rocket
+    if rocket.aero.model != "linear" and rocket.aero.tables == "buildup" and not math.isnan(max_mach) \
+            and max_mach > MAX_SUBSONIC_MACH:  # fmt: skip
+        lines.append(f"{name}: flights reach Mach {max_mach:.3g}, beyond the build-up's subsonic theory "
+                     f"(Mach {MAX_SUBSONIC_MACH:g}; compressibility held there)")  # fmt: skip
+    if outside_tables:
+        lines.append(f"{name}: {outside_tables} flight(s) left the aerodynamic tables' range (angle of attack, "
+                     "sideslip, Mach or altitude) in powered or coasting flight")  # fmt: skip
+    return lines

@@ -1,0 +1,56 @@
+"""The warnings before and after flying (issue 19, parts 4.2 and 4.3): a statically unstable nominal rocket
+and flights beyond the aerodynamic tables' range or the build-up's subsonic theory."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+
+from rocketmc.aero.buildup import MAX_SUBSONIC_MACH
+from rocketmc.campaign import campaign_from_dict
+from rocketmc.campaign.checks import aero_validity_warnings, nominal_static_margins, stability_warnings
+
+from ..conftest import CAMPAIGNS
+
+RAW = tomllib.loads((CAMPAIGNS / "lynx_ballistic.toml").read_text())
+
+
+def ballistic(**rocket):
+    raw = {**RAW, "rocket": {**RAW["rocket"], **rocket}, "dispersions": {}}
+    return campaign_from_dict(raw, CAMPAIGNS)
+
+
+@pytest.fixture(scope="module")
+def lynx():
+    return ballistic()
+
+
+def test_lynx_is_stable_and_says_nothing(lynx):
+    """Lynx: 0.27 calibers at liftoff, 0.82 at burnout (`rocketmc aero derivatives lynx`, Mach 0.3)."""
+    margins = nominal_static_margins(lynx)
+    assert margins["liftoff"] == pytest.approx(0.27, abs=0.01) and margins["burnout"] == pytest.approx(0.82, abs=0.01)
+    assert stability_warnings(lynx) == []
+
+
+def test_a_dry_cg_moved_aft_is_unstable_and_warned():
+    """The dry CG 0.5 m aft moves the whole CG ~0.3 m aft (the dry mass is ~60 % of the liftoff mass): about
+    −2 calibers at liftoff; the margin moves by the CG's shift over d, so one line per instant."""
+    lines = stability_warnings(ballistic(preset="lynx", dry_cg_m=1.83))
+    assert len(lines) == 2 and all("statically unstable" in line and "calibers" in line for line in lines), lines
+    assert "at liftoff" in lines[0] and "at burnout" in lines[1]
+
+
+def test_flights_beyond_the_tables_are_warned(lynx):
+    assert aero_validity_warnings(lynx, 0.5, 3000.0 + lynx.config.site.altitude_m) == []
+    top = float(lynx.aero.body.axes[lynx.aero.body.axis_names.index("mach")][-1])
+    lines = aero_validity_warnings(lynx, top + 0.1, None, outside_tables=7)
+    assert any("beyond the aerodynamic tables'" in line and "mach" in line for line in lines), lines
+    assert any(f"Mach {MAX_SUBSONIC_MACH:g}" in line for line in lines), lines  # built-up tables: subsonic theory
+    assert any(line.startswith(f"{lynx.config.name}: 7 flight(s) left") for line in lines), lines
+
+
+def test_the_subsonic_limit_holds_for_built_up_tables_only(lynx):
+    """Between the build-up's Mach 0.9 and the tables' top only the theory's warning is said."""
+    lines = aero_validity_warnings(lynx, MAX_SUBSONIC_MACH + 0.01)
+    assert len(lines) == 1 and "subsonic theory" in lines[0], lines
