@@ -120,11 +120,14 @@ def _validity_warnings(campaign, path: Path) -> list[str]:
     import numpy as np
 
     from .campaign.checks import aero_validity_warnings
+    from .sim.flight import OUTSIDE_TABLES_QBAR_FRACTION
 
+    names = ("max_mach", "apogee_agl_m", "max_dynamic_pressure_pa", "max_dynamic_pressure_outside_aero_tables_pa")
     with h5py.File(path, "r") as f:
-        outputs = {name: f[f"outputs/{name}"][()] for name in ("max_mach", "apogee_agl_m", "max_dynamic_pressure_outside_aero_tables_pa")}  # fmt: skip
+        outputs = {name: f[f"outputs/{name}"][()] for name in names}
     top = lambda values: float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")  # noqa: E731
-    outside = int((outputs["max_dynamic_pressure_outside_aero_tables_pa"] > 0).sum())
+    qbar = outputs["max_dynamic_pressure_pa"]
+    outside = int((outputs["max_dynamic_pressure_outside_aero_tables_pa"] > OUTSIDE_TABLES_QBAR_FRACTION * qbar).sum())
     return aero_validity_warnings(campaign, top(outputs["max_mach"]),
                                   top(outputs["apogee_agl_m"]) + campaign.config.site.altitude_m, outside)  # fmt: skip
 

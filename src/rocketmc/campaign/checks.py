@@ -12,7 +12,7 @@ import numpy as np
 from ..aero.buildup import MAX_SUBSONIC_MACH
 from ..aero.model import LinearAero
 from ..aero.stability import static_margin_calibers
-from ..sim.flight import mass_properties
+from ..sim.flight import OUTSIDE_TABLES_QBAR_FRACTION, mass_properties
 from ..sim.params import FlightParams
 from .config import Campaign
 from .model import nominal_params
@@ -54,8 +54,9 @@ def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: 
     """Warning lines where flights went beyond the aerodynamic method: ``max_mach`` (the largest Mach number
     flown) above the tables' Mach axis (values clamped at its edge) or, for built-up tables, above the
     subsonic theory's ``MAX_SUBSONIC_MACH``; ``max_altitude_m`` [m MSL] above the tables' altitude axis;
-    ``outside_tables`` flights that flew outside any axis (α, β, Mach, altitude) at a dynamic pressure > 0
-    (``/outputs/max_dynamic_pressure_outside_aero_tables_pa``). NaN maxima (no flight ok) are skipped."""
+    ``outside_tables`` flights that flew outside any axis (α, β, Mach, altitude) at more than
+    ``sim.flight.OUTSIDE_TABLES_QBAR_FRACTION`` of their maximum dynamic pressure (status 3's criterion, counted
+    whatever status a flight ended with). NaN maxima (no flight ok) are skipped."""
     aero = campaign.aero if campaign.aero is not None else nominal_params(campaign).rocket.aero
     tables = [aero.table] if isinstance(aero, LinearAero) else [t for t in (aero.body, aero.canard_table) if t]
     name, lines = campaign.config.name, []
@@ -71,5 +72,6 @@ def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: 
                      f"(Mach {MAX_SUBSONIC_MACH:g}; compressibility held there)")  # fmt: skip
     if outside_tables:
         lines.append(f"{name}: {outside_tables} flight(s) left the aerodynamic tables' range (angle of attack, "
-                     "sideslip, Mach or altitude) in powered or coasting flight")  # fmt: skip
+                     f"sideslip, Mach or altitude) at more than {OUTSIDE_TABLES_QBAR_FRACTION:.0%} of their maximum "
+                     "dynamic pressure")  # fmt: skip
     return lines
