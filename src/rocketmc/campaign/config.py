@@ -1006,20 +1006,26 @@ def _drawable_values(d: Dispersion, nominal_value: float, field: str) -> list[tu
     ]
 
 
+def fixed_reason(path: str) -> str | None:
+    """Why the number at dotted ``path`` is fixed for the whole campaign (not dispersible), or None."""
+    if path.startswith(FIXED_PER_CAMPAIGN) and not path.startswith(DISPERSIBLE_AERO):
+        return ("fixed for the whole campaign (it defines the body frame or builds the aerodynamic tables); "
+                "disperse rocket.aero.drag_scale or rocket.aero.cl0 instead")  # fmt: skip
+    if path.startswith("avionics.") and path.rstrip("0123456789.").endswith(FIXED_AVIONICS):
+        return "fixed for the whole campaign (a sensor's schedule is set once, and its per-flight spreads are dispersions already)"
+    if path.startswith(FIXED_GNC):
+        return ("fixed for the whole campaign (guidance, the LQI gains and the navigation filters are set once, "
+                "when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
+    return None
+
+
 def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> None:
     """Each dispersion names a dispersible number and every value it can draw passes validation."""
     data = config.model_dump(exclude={"dispersions"})
     for path, d in config.dispersions.items():
         field = f"dispersions.{path}"
-        if path.startswith(FIXED_PER_CAMPAIGN) and not path.startswith(DISPERSIBLE_AERO):
-            raise ConfigError(f"{field}: fixed for the whole campaign (it defines the body frame or builds the "
-                              "aerodynamic tables); disperse rocket.aero.drag_scale or rocket.aero.cl0 instead")  # fmt: skip
-        if path.startswith("avionics.") and path.rstrip("0123456789.").endswith(FIXED_AVIONICS):
-            raise ConfigError(f"{field}: fixed for the whole campaign (a sensor's schedule is set once, and its "
-                              "per-flight spreads are dispersions already)")  # fmt: skip
-        if path.startswith(FIXED_GNC):
-            raise ConfigError(f"{field}: fixed for the whole campaign (guidance, the LQI gains and the navigation "
-                              "filters are set once, when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
+        if (reason := fixed_reason(path)) is not None:
+            raise ConfigError(f"{field}: {reason}")
         if path not in nominal:
             raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
                               f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
