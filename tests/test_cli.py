@@ -1,5 +1,6 @@
 """The command line: a small campaign end to end, and bad input (exit code 2, no result file)."""
 
+import argparse
 import itertools
 import json
 import re
@@ -177,3 +178,47 @@ def test_help_matches_the_readme(capsys):
         for option, values in choices.items():
             shown = re.search(r"\{([^}]*)\}" if option is None else re.escape(option) + r" \{([^}]*)\}", text)
             assert shown and set(shown.group(1).split(",")) == values, (words, option)
+
+
+def _subcommands(parser, words=()):
+    """(words, parser) of every subcommand, nested ones (aero derivatives) included."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield from _subcommands(sub, (*words, name))
+    if words and not any(isinstance(a, argparse._SubParsersAction) for a in parser._actions):
+        yield words, parser
+
+
+def test_options_are_spelled_the_same_everywhere():
+    """Issue 19.4: one meaning (argparse's dest) has one spelling in every subcommand and one spelling one
+    meaning, except the old spellings kept (cli.OLD_SPELLINGS, each after the current one); a folder option's
+    name ends in -dir, and only those take a DIR."""
+    from rocketmc.cli import OLD_SPELLINGS, build_parser
+
+    spelling_of, meaning_of = {}, {}
+    commands = list(_subcommands(build_parser()))
+    assert len(commands) >= 9
+    for words, parser in commands:
+        for action in parser._actions:
+            if not action.option_strings or action.dest == "help":
+                continue
+            current, *old = action.option_strings
+            where = (words, current)
+            assert spelling_of.setdefault(action.dest, current) == current, where
+            assert meaning_of.setdefault(current, action.dest) == action.dest, where
+            assert all(OLD_SPELLINGS.get(o) == current for o in old), where
+            assert current.endswith("-dir") == (action.metavar == "DIR"), where
+    assert spelling_of["out"] == "--out" and spelling_of["plot_dir"] == "--plot-dir" and spelling_of["n"] == "-n"
+
+
+@pytest.mark.parametrize("old, new", [
+    (["validate", "euroc-2021", "--plot", "x"], ["validate", "euroc-2021", "--plot-dir", "x"]),
+    (["navigate", "log", "--plot", "x"], ["navigate", "log", "--plot-dir", "x"]),
+    (["sensors", "simulate", "c.toml", "--out", "x"], ["sensors", "simulate", "c.toml", "--out-dir", "x"]),
+    (["bench", "--n", "10", "20", "--models", "linear"], ["bench", "-n", "10", "20", "--aero-model", "linear"]),
+])  # fmt: skip
+def test_old_spellings_still_parse_as_the_new(old, new):
+    from rocketmc.cli import build_parser
+
+    assert vars(build_parser().parse_args(old)) == vars(build_parser().parse_args(new))

@@ -313,13 +313,13 @@ def _sensors_simulate(args) -> int:
     from .campaign.sensor_record import sensor_record
 
     for file, _ in LOG_FILES.values():
-        _refuse_existing("--out", Path(args.out) / file, args.force)
+        _refuse_existing("--out-dir", Path(args.out_dir) / file, args.force)
     campaign = _campaign(args.campaign)
     logs = sensor_record(campaign, args.realization, args.static,
                          log=lambda line: None if args.quiet else print(line, file=sys.stderr))  # fmt: skip
-    write_sensor_log(args.out, logs)
+    write_sensor_log(args.out_dir, logs)
     for name, frame in logs.items() if not args.quiet else ():
-        print(f"wrote {Path(args.out) / LOG_FILES[name][0]}: {len(frame)} samples", file=sys.stderr)
+        print(f"wrote {Path(args.out_dir) / LOG_FILES[name][0]}: {len(frame)} samples", file=sys.stderr)
     return 0
 
 
@@ -355,8 +355,8 @@ def _navigate(args) -> int:
         log = read_sensor_log(args.log_dir)
     except ValueError as e:
         raise RocketmcError(str(e)) from None
-    if args.plot:  # before the replay: a folder that cannot be made is said at once
-        Path(args.plot).mkdir(parents=True, exist_ok=True)
+    if args.plot_dir:  # before the replay: a folder that cannot be made is said at once
+        Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     params = nav_replay.retuned(filter_params(campaign), None if args.barometer is None else args.barometer == "on",
                                 args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std)  # fmt: skip
     launch, site = config.launch, config.site
@@ -392,8 +392,8 @@ def _navigate(args) -> int:
         with replacing(out) as partial:
             nav.to_csv(partial, index=False, lineterminator="\n")
         say(f"wrote {out}: {len(nav)} ticks")
-    if args.plot:
-        for path in nav_replay.plot_navigation({config.name: nav}, log, windows, args.plot, Path(args.log_dir).name):
+    if args.plot_dir:
+        for path in nav_replay.plot_navigation({config.name: nav}, log, windows, args.plot_dir, Path(args.log_dir).name):
             say(f"wrote {path}")
     return 0
 
@@ -415,12 +415,12 @@ def _validate(args) -> int:
     path = args.campaign or Path(str(resources.files("rocketmc") / "data" / "campaigns" / FLIGHTS[args.flight]))
     campaign = _campaign(path)
     if args.flight == "roccaraso-2021":
-        if args.plot:  # before the flight: a folder that cannot be made is said at once
-            Path(args.plot).mkdir(parents=True, exist_ok=True)
+        if args.plot_dir:  # before the flight: a folder that cannot be made is said at once
+            Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
         reduction = reduce_flight(load_roccaraso_2021())
         checks, flight = validate_roccaraso(campaign, reduction)
-        if args.plot:
-            plot_against_log(flight, reduction, Path(args.plot) / "roccaraso_2021.png")
+        if args.plot_dir:
+            plot_against_log(flight, reduction, Path(args.plot_dir) / "roccaraso_2021.png")
     else:
         checks = validate_euroc(campaign)
     if args.json:
@@ -433,8 +433,8 @@ def _validate(args) -> int:
                 else (f"{c.error:+.2f} {c.unit}", f"{c.tolerance:g} {c.unit}" if c.tolerance else "")  # fmt: skip
             verdict = {True: "ok", False: "FAIL", None: ""}[c.passed]
             print(f"  {c.name + f' [{c.unit}]':<40}{c.simulated:>11.2f}{c.measured:>11.2f}{error:>10}{bound:>9}  {verdict}")
-        if args.plot and args.flight == "roccaraso-2021":
-            print(f"wrote {Path(args.plot) / 'roccaraso_2021.png'}")
+        if args.plot_dir and args.flight == "roccaraso-2021":
+            print(f"wrote {Path(args.plot_dir) / 'roccaraso_2021.png'}")
     return 0 if all(c.passed is not False for c in checks) else 1
 
 
@@ -444,7 +444,7 @@ def _bench(args) -> int:
 
     campaign = args.campaign or DEFAULT_CAMPAIGN
     try:
-        report = run_benchmarks(campaign, tuple(args.sizes), tuple(args.models), tuple(args.precision),
+        report = run_benchmarks(campaign, tuple(args.n), tuple(args.aero_model), tuple(args.precision),
                                 args.chunk_size, log=lambda line: print(line, file=sys.stderr, flush=True))  # fmt: skip
     except ConfigError as e:
         raise RocketmcError(f"{campaign}: {e}") from None
@@ -454,7 +454,15 @@ def _bench(args) -> int:
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
+OLD_SPELLINGS = {"--plot": "--plot-dir", "--out": "--out-dir", "--n": "-n", "--models": "--aero-model"}
+"""Spellings users relied on before an option was renamed, and the name it has now (still accepted where it was:
+``navigate``/``validate --plot`` and ``sensors simulate --out`` took folders, ``bench --n`` and ``--models``).
+Everywhere else an option has one spelling and one meaning: ``--out``/``--plot`` a file, ``--out-dir``/
+``--plot-dir`` a folder, ``-n`` realizations, ``--aero-model`` the aerodynamic model(s) (tests/test_cli.py)."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``rocketmc`` argument parser with every subcommand."""
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
     parser.add_argument("--version", action="version", version=f"rocketmc {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -524,7 +532,8 @@ def main(argv: list[str] | None = None) -> int:
                           help="the realization whose drawn errors and gusts are flown (default 0)")  # fmt: skip
     simulate.add_argument("--static", type=float, metavar="SECONDS",
                           help="instead, the rocket at rest on the pad for this long (noise analysis)")  # fmt: skip
-    simulate.add_argument("--out", required=True, metavar="DIR", help="folder for the CSV files")
+    simulate.add_argument("--out-dir", "--out", dest="out_dir", required=True, metavar="DIR",
+                          help="folder for the CSV files (--out: its old spelling)")  # fmt: skip
     simulate.add_argument("--force", action="store_true", help="replace the CSV files of a log already in --out")
     simulate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     navigate = commands.add_parser(
@@ -534,7 +543,8 @@ def main(argv: list[str] | None = None) -> int:
                           help="the campaign whose site, rail (the attitude at liftoff) and [gnc.filters] tuning are "
                                "used: a shipped campaign's name or a campaign file (default: lynx_roccaraso_2021)")  # fmt: skip
     navigate.add_argument("--out", metavar="NAV.csv", help="write the estimates at every tick to this CSV file")
-    navigate.add_argument("--plot", metavar="DIR", help="folder for the figures (height, velocity, its direction, attitude)")
+    navigate.add_argument("--plot-dir", "--plot", dest="plot_dir", metavar="DIR",
+                          help="folder for the figures (height, velocity, its direction, attitude; --plot: its old spelling)")  # fmt: skip
     navigate.add_argument("--barometer", choices=("on", "off"), help="the barometric height update (default: the campaign's)")
     navigate.add_argument("--gnss", choices=("all", "horizontal"),
                           help="GNSS updates of every axis or of north and east only (default: the campaign's)")  # fmt: skip
@@ -550,7 +560,8 @@ def main(argv: list[str] | None = None) -> int:
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
     validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
-    validate.add_argument("--plot", help="folder for the overlay plots (roccaraso-2021)")
+    validate.add_argument("--plot-dir", "--plot", dest="plot_dir", metavar="DIR",
+                          help="folder for the overlay plots (roccaraso-2021; --plot: its old spelling)")  # fmt: skip
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
     bench = commands.add_parser(
         "bench", help="measure this machine: flights/s, compile time, peak memory, float32 against float64",
@@ -561,9 +572,10 @@ def main(argv: list[str] | None = None) -> int:
         "together. A few minutes with the defaults.",
     )  # fmt: skip
     bench.add_argument("--campaign", metavar="FILE", help="campaign file (default: the built-in lynx_nominal)")
-    bench.add_argument("--n", dest="sizes", type=int, nargs="+", default=[1000], metavar="N",
+    bench.add_argument("-n", "--n", dest="n", type=int, nargs="+", default=[1000], metavar="N",
                        help="numbers of realizations, one measurement each (default: 1000)")  # fmt: skip
-    bench.add_argument("--models", nargs="+", choices=("simplified", "interpolated", "linear"), metavar="MODEL",
+    bench.add_argument("--aero-model", "--models", dest="aero_model", nargs="+", metavar="MODEL",
+                       choices=("simplified", "interpolated", "linear"),
                        default=["simplified", "interpolated"],
                        help="aerodynamic models among simplified, interpolated, linear "
                             "(default: simplified interpolated)")  # fmt: skip
@@ -572,14 +584,19 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--chunk-size", type=int, metavar="C",
                        help="realizations per compiled chunk (default: the campaign's)")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print the results as JSON instead of a table")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
     args = parser.parse_args(argv)
-    if min(getattr(args, "sizes", [1])) < 1:
-        parser.error("--n must be at least 1")
+    if args.command == "bench" and min(args.n) < 1:
+        parser.error("-n/--n must be at least 1")
     if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
         parser.error("--until-converged must be a percentage in (0, 100]")
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
-    for name in ("n", "chunk_size", "workers"):
+    for name in ("n", "chunk_size", "workers") if args.command != "bench" else ("chunk_size",):
         if getattr(args, name, None) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
     if (getattr(args, "workers", None) or 0) > CORES:
