@@ -472,7 +472,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
     run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
-    run.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
+    run.add_argument("--quiet", action="store_true", help="no progress messages (errors and warnings only)")
     run.add_argument("--until-converged", type=float, metavar="PCT",
                      help="add chunks (up to N) until the 95 %% ellipse area's 95 %% bootstrap interval is "
                           "narrower than PCT %% of the area; the file keeps the N reached")  # fmt: skip
