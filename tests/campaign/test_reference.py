@@ -33,5 +33,6 @@ def test_every_key_of_the_shipped_campaigns_is_in_the_reference():
 
 
 def test_units_follow_the_name_s_suffix():
-    assert (unit("dry_inertia_kgm2"), unit("area_m2"), unit("speed_mps"), unit("delay_s"), unit("cd")) == \
-        ("kg·m²", "m²", "m/s", "s", "")  # fmt: skip
+    assert (unit("dry_inertia_kgm2"), unit("area_m2"), unit("speed_mps"), unit("delay_s"), unit("cd"),
+            unit("roll_rate_limit_deg_s"), unit("bias_walk_deg_s2"), unit("vibration_per_kpa")) == \
+        ("kg·m²", "m²", "m/s", "s", "", "deg/s", "deg/s²", "unit/kPa")  # fmt: skip

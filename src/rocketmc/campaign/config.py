@@ -126,16 +126,16 @@ class MotorConfig(_Strict):
     """Solid motor; positions in the rocket's coordinates [m]."""
 
     thrust_curve: str = Field(description="RASP .eng or CSV (time s, thrust N); built-in name or path")
-    propellant_mass_kg: Mass
+    propellant_mass_kg: Mass = Field(description="propellant mass at ignition, all of it burnt by the curve's end")
     isp_s: float | None = Field(
         None, gt=0, le=MAX_ISP_S, description="checked against the curve's impulse / propellant"
     )
-    ignition_delay_s: Delay = 0.0
-    thrust_scale: Scale = 1.0
-    nozzle_m: Position
-    grain_outer_diameter_m: Diameter
-    grain_inner_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M)
-    grain_length_m: Length
+    ignition_delay_s: Delay = Field(0.0, description="ignition after the start of the simulation, on the rail")
+    thrust_scale: Scale = Field(1.0, description="multiplies the thrust curve (the burn time unchanged)")
+    nozzle_m: Position = Field(description="the nozzle exit, in the rocket's coordinates [m]")
+    grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward)")
+    grain_inner_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M, description="the grain's initial core diameter")
+    grain_length_m: Length = Field(description="the grain's length along the axis")
     grain_center_m: Position | None = Field(None, description="default: the grain ends at the nozzle exit")
     dry_mass_kg: float = Field(0.0, ge=0, le=MAX_MASS_KG,
                                description="casing, nozzle, closures: 0 if the rocket's dry mass has them")
@@ -163,20 +163,21 @@ class LinearCoefficientsConfig(_Strict):
     u = (yaw, pitch, roll, squeeze) as in the thesis (aero/model.py, ``from_virtual_commands``);
     damping per ω·d/(2V)."""
 
-    reference_area_m2: Area
-    reference_length_m: Length
-    ca0_mach: list[Mach] = Field(min_length=2)
-    ca0: list[DragCoefficient] = Field(min_length=2)
-    ca_u: list[Coefficient] = Field([0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4)
-    cn_alpha: Coefficient
-    cn_delta: Coefficient = 0.0
-    cm_alpha: Coefficient
-    cm_delta: Coefficient = 0.0
-    cl_delta: Coefficient = 0.0
-    cy_r: DampingCoefficient = 0.0
-    cn_q: DampingCoefficient = 0.0
-    cl_p: Damping = 0.0
-    cm_q: Damping = 0.0
+    reference_area_m2: Area = Field(description="S of the coefficients")
+    reference_length_m: Length = Field(description="d of the coefficients (moments, rates)")
+    ca0_mach: list[Mach] = Field(min_length=2, description="Mach numbers of ca0, increasing")
+    ca0: list[DragCoefficient] = Field(min_length=2, description="zero-lift axial force at ca0_mach")
+    ca_u: list[Coefficient] = Field([0.0, 0.0, 0.0, 0.0], min_length=4, max_length=4,
+                                    description="axial force per command squared (yaw, pitch, roll, squeeze) [per rad²]")
+    cn_alpha: Coefficient = Field(description="normal-force slope CNα [per rad]")
+    cn_delta: Coefficient = Field(0.0, description="normal force per pitch (and yaw) command [per rad]")
+    cm_alpha: Coefficient = Field(description="pitching-moment slope Cmα about the reference point [per rad]")
+    cm_delta: Coefficient = Field(0.0, description="pitching moment per pitch (and yaw) command [per rad]")
+    cl_delta: Coefficient = Field(0.0, description="rolling moment per roll command [per rad]")
+    cy_r: DampingCoefficient = Field(0.0, description="side force per yaw rate ω·d/(2V)")
+    cn_q: DampingCoefficient = Field(0.0, description="normal force per pitch rate ω·d/(2V)")
+    cl_p: Damping = Field(0.0, description="roll damping per roll rate ω·d/(2V)")
+    cm_q: Damping = Field(0.0, description="pitch damping per pitch rate ω·d/(2V)")
 
     @model_validator(mode="after")
     def _mach_table(self):
@@ -197,12 +198,12 @@ class AeroConfig(_Strict):
         description="'buildup' (from [rocket.geometry]), a built-in table name, or a .h5/.csv/.mat file",
     )
     reference_area_m2: Area | None = Field(None, description="for table files that do not state it")
-    reference_length_m: Length | None = None
+    reference_length_m: Length | None = Field(None, description="d, for table files that do not state it")
     moment_reference_m: Position | None = Field(None, description="for table files that do not state it")
     cd_mach: list[Mach] | None = Field(None, description="Cd-vs-Mach curve replacing the zero-lift axial force")
-    cd: list[DragCoefficient] | None = None
+    cd: list[DragCoefficient] | None = Field(None, description="Cd at cd_mach (with the motor off)")
     cd_power_on: list[DragCoefficient] | None = Field(None, description="Cd at cd_mach while the motor burns")
-    drag_scale: Scale = 1.0
+    drag_scale: Scale = Field(1.0, description="multiplies the axial force (dispersible)")
     cl0: Coefficient = Field(0.0, description="rolling-moment offset (fin misalignment)")
     linear: LinearCoefficientsConfig | None = None
 
@@ -220,35 +221,37 @@ class AeroConfig(_Strict):
 
 
 class NoseConfig(_Strict):
-    kind: Literal[NOSE_KINDS]
-    length_m: Length
+    """The nose cone."""
+
+    kind: Literal[NOSE_KINDS] = Field(description="the nose cone's profile")
+    length_m: Length = Field(description="from the tip to the shoulder")
 
 
 class FinSetConfig(_Strict):
     """Trapezoidal panels (aero/geometry.py ``FinSet``); position_m: the root's leading edge."""
 
-    count: int = Field(ge=1, le=8)
-    root_chord_m: Length
-    tip_chord_m: float = Field(ge=0, le=MAX_LENGTH_M)
-    span_m: Length
-    sweep_m: Position = 0.0
-    position_m: Position
-    thickness_m: Length = 0.005
-    cant_deg: float = Field(0.0, ge=-15, le=15)
-    first_panel_deg: Direction = 0.0
+    count: int = Field(ge=1, le=8, description="panels, evenly spaced in roll")
+    root_chord_m: Length = Field(description="chord along the body")
+    tip_chord_m: float = Field(ge=0, le=MAX_LENGTH_M, description="chord at the tip (0: a delta)")
+    span_m: Length = Field(description="from the body to the tip")
+    sweep_m: Position = Field(0.0, description="the tip's leading edge aft of the root's [m]")
+    position_m: Position = Field(description="the root's leading edge, in the rocket's coordinates [m]")
+    thickness_m: Length = Field(0.005, description="panel thickness")
+    cant_deg: float = Field(0.0, ge=-15, le=15, description="cant angle, positive as a positive deflection")
+    first_panel_deg: Direction = Field(0.0, description="roll position of panel 1, 0 up, 90 starboard")
 
 
 class BoatTailConfig(_Strict):
-    length_m: Length
-    aft_diameter_m: Diameter
-    position_m: Position
+    length_m: Length = Field(description="along the axis")
+    aft_diameter_m: Diameter = Field(description="the diameter at its aft end, below the body's")
+    position_m: Position = Field(description="its forward end, in the rocket's coordinates [m]")
 
 
 class GeometryConfig(_Strict):
     """External shape for the aerodynamic build-up; positions in the rocket's coordinates [m]."""
 
-    body_diameter_m: Diameter
-    length_m: Length
+    body_diameter_m: Diameter = Field(description="the body tube's diameter (the reference length d)")
+    length_m: Length = Field(description="from the nose tip to the aft end")
     nose: NoseConfig
     fins: list[FinSetConfig] = []
     canards: FinSetConfig | None = None
@@ -281,12 +284,13 @@ class GeometryConfig(_Strict):
 class ParachuteConfig(_Strict):
     """A canopy: opens at apogee, or at deploy_altitude_m above ground after apogee."""
 
-    name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
-    cd: float = Field(gt=0, le=MAX_DRAG_COEFFICIENT)
-    area_m2: Area
-    deploy_altitude_m: float | None = Field(None, ge=0, le=MAX_ALTITUDE_M)
-    delay_s: Delay = 0.0
-    opening_time_s: Delay = 0.0
+    name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description="an identifier; names /outputs/<name>_deploy_time_s")
+    cd: float = Field(gt=0, le=MAX_DRAG_COEFFICIENT, description="drag coefficient on area_m2")
+    area_m2: Area = Field(description="reference area of cd")
+    deploy_altitude_m: float | None = Field(None, ge=0, le=MAX_ALTITUDE_M,
+                                            description="above the pad, after apogee (none: at apogee)")
+    delay_s: Delay = Field(0.0, description="from the trigger to the start of opening")
+    opening_time_s: Delay = Field(0.0, description="the drag area grows linearly over it")
     attach_m: Position
 
 
@@ -294,8 +298,10 @@ class AirbrakesConfig(_Strict):
     """Extra axial-force coefficient ΔCA (on the aerodynamic reference area) of deployed airbrakes as a
     schedule of time since motor ignition [s], linear in between, 0 outside."""
 
-    time_s: list[Annotated[float, Field(ge=0, le=MAX_FLIGHT_TIME_S)]] = Field(min_length=2)
-    delta_ca: list[DragCoefficient] = Field(min_length=2)
+    time_s: list[Annotated[float, Field(ge=0, le=MAX_FLIGHT_TIME_S)]] = Field(
+        min_length=2, description="schedule times since motor ignition, increasing"
+    )
+    delta_ca: list[DragCoefficient] = Field(min_length=2, description="ΔCA at time_s")
 
     @model_validator(mode="after")
     def _schedule(self):
@@ -311,14 +317,18 @@ class RocketConfig(_Strict):
     ``nose_to_tail`` (positive aft) or ``tail_to_nose`` (positive forward, RocketPy's default),
     from an origin of the user's choice where the nose tip is at ``nose_position_m``."""
 
-    coordinate_system: Literal["nose_to_tail", "tail_to_nose"] = "nose_to_tail"
+    coordinate_system: Literal["nose_to_tail", "tail_to_nose"] = Field(
+        "nose_to_tail", description="the direction positions grow in: aft, or toward the nose (RocketPy's)"
+    )
     nose_position_m: Position = 0.0
     reference_point_m: Position = Field(description="origin of the body frame and, by default, the moment reference")
-    dry_mass_kg: Mass
+    dry_mass_kg: Mass = Field(
+        description="the rocket without propellant; the motor's casing included unless rocket.motor.dry_mass_kg gives it apart"
+    )
     dry_cg_m: Position
     dry_inertia_kgm2: list[Inertia] = Field(min_length=2, max_length=2, description="[axial, transverse]")
     rear_lug_m: Position
-    canopy_roll_damping: Damping = -5.0
+    canopy_roll_damping: Damping = Field(-5.0, description="roll damping Clp under an open canopy, per ω·d/(2V)")
     motor: MotorConfig
     aero: AeroConfig = AeroConfig()
     geometry: GeometryConfig | None = None
@@ -345,20 +355,26 @@ class RocketConfig(_Strict):
 
 
 class SiteConfig(_Strict):
-    name: str = ""
-    latitude_deg: float = Field(ge=-90, le=90)
-    longitude_deg: float = Field(ge=-180, le=360)
+    """The launch site: the pad's position (the NED origin)."""
+
+    name: str = Field("", description="a label")
+    latitude_deg: float = Field(ge=-90, le=90, description="the pad's geodetic latitude, north positive")
+    longitude_deg: float = Field(ge=-180, le=360, description="the pad's longitude, east positive")
     altitude_m: float = Field(ge=-400, le=30000, description="pad altitude above mean sea level")
 
 
 class LaunchConfig(_Strict):
-    rail_length_m: Length
+    """The launch rail."""
+
+    rail_length_m: Length = Field(description="the rail's length; the rocket leaves when its rear lug passes the end")
     elevation_deg: float = Field(gt=0, le=90, description="rail angle above the horizon")
     azimuth_deg: Direction = Field(description="clockwise from north")
 
 
 class WindLayerConfig(_Strict):
-    speed_mps: WindSpeed
+    """One layer of piecewise constant wind, from the layer below's top (the pad for the first)."""
+
+    speed_mps: WindSpeed = Field(description="horizontal wind speed in the layer")
     from_deg: Direction = Field(description="direction the wind blows from, clockwise from north")
     thickness_m: Height | None = Field(None, description="not needed for the top layer")
 
@@ -379,8 +395,8 @@ class WindConfig(_Strict):
     (speed at a reference height, V ∝ h^exponent) or ``profile`` (a CSV file of altitude, speed and
     direction, linear in between; ``speed_scale`` multiplies it and can be dispersed)."""
 
-    model: Literal["layers", "constant", "power_law", "profile"] = "layers"
-    layers: list[WindLayerConfig] | None = Field(None, min_length=1)
+    model: Literal["layers", "constant", "power_law", "profile"] = Field("layers", description="how the mean wind is given")
+    layers: list[WindLayerConfig] | None = Field(None, min_length=1, description="the layers, from the pad up")
     speed_mps: WindSpeed | None = Field(None, description="constant wind, or power law at reference_height_m")
     from_deg: Direction | None = Field(None, description="direction the wind blows from")
     reference_height_m: float | None = Field(
@@ -388,7 +404,7 @@ class WindConfig(_Strict):
     )
     exponent: float | None = Field(None, ge=0, le=1, description="power-law exponent (1/7 over open terrain)")
     file: str | None = Field(None, description="CSV: altitude_agl_m (or altitude_msl_m), speed_mps, from_deg")
-    speed_scale: float | None = Field(None, ge=0, le=MAX_SCALE)
+    speed_scale: float | None = Field(None, ge=0, le=MAX_SCALE, description="multiplies the profile's speeds")
 
     @model_validator(mode="before")
     @classmethod
@@ -420,11 +436,13 @@ class TurbulenceConfig(_Strict):
     exceedance curves 10⁻², 10⁻³, 10⁻⁵); w20_mps the wind at 20 ft for the low-altitude intensities,
     by default 15/30/45 kt from the severity."""
 
-    severity: float = Field(ge=0, le=3)
-    w20_mps: WindSpeed | None = None
+    severity: float = Field(ge=0, le=3, description="0 none, 1 light, 2 moderate, 3 severe")
+    w20_mps: WindSpeed | None = Field(None, description="wind at 20 ft for the low-altitude intensities")
 
 
 class EnvironmentConfig(_Strict):
+    """The air the rocket flies through: mean wind and turbulence."""
+
     wind: WindConfig = WindConfig()
     turbulence: TurbulenceConfig | None = None
 
@@ -433,13 +451,13 @@ class Dispersion(_Strict):
     """How one parameter is drawn: normal (mean defaults to the nominal value; optional low/high
     clip the draw), uniform [low, high], or a choice among values (optional weights)."""
 
-    dist: Literal["normal", "uniform", "choice"]
-    mean: float | None = None
-    std: NonNegative | None = None
-    low: float | None = None
-    high: float | None = None
-    values: list[float] | None = Field(None, min_length=1)
-    weights: list[NonNegative] | None = None
+    dist: Literal["normal", "uniform", "choice"] = Field(description="the distribution")
+    mean: float | None = Field(None, description="normal: its mean (none: the nominal value), in the parameter's unit")
+    std: NonNegative | None = Field(None, description="normal: its standard deviation, in the parameter's unit")
+    low: float | None = Field(None, description="uniform: the lower end; normal: the clip below")
+    high: float | None = Field(None, description="uniform: the upper end; normal: the clip above")
+    values: list[float] | None = Field(None, min_length=1, description="choice: the values drawn among")
+    weights: list[NonNegative] | None = Field(None, description="choice: relative weights of values (none: equal)")
 
     @model_validator(mode="after")
     def _parameters(self):
@@ -495,16 +513,16 @@ class GuidanceConfig(_Strict):
     climbs apogee_m [m] after t0_s [s] from a flight-path angle flight_path_angle_deg above the horizon,
     toward heading_deg (clockwise from north; None: launch.azimuth_deg)."""
 
-    apogee_m: Height = 1614.0
+    apogee_m: Height = Field(1614.0, description="the reference parabola's climb after t0_s")
     t0_s: float = Field(1.5, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
-    flight_path_angle_deg: float = Field(84.0, gt=0, lt=90)
-    heading_deg: Direction | None = None
+    flight_path_angle_deg: float = Field(84.0, gt=0, lt=90, description="the parabola's initial angle above the horizon")
+    heading_deg: Direction | None = Field(None, description="clockwise from north (none: launch.azimuth_deg)")
     gain: float = Field(5.0, ge=0, le=MAX_GUIDANCE_GAIN, description="k [1/s]")
     rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S, description="pitch/yaw command, 2-norm")
     min_speed_mps: float = Field(1.0, ge=0, le=MAX_SPEED_MPS, description="no pitch/yaw command below")
     roll_gain: float = Field(1.0, ge=0, le=MAX_GUIDANCE_GAIN, description="[1/s]")
     roll_heading_deg: Direction = Field(90.0, description="azimuth the body z axis is steered toward")
-    roll_rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S)
+    roll_rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S, description="largest commanded roll rate [deg/s]")
     integrator_gain: list[Annotated[float, Field(ge=0, le=MAX_GUIDANCE_GAIN)]] = Field(
         [1.0, 12.0, 12.0], min_length=3, max_length=3, description="k_int of e_p, e_q, e_r [-]"
     )
@@ -526,15 +544,20 @@ class ControlConfig(_Strict):
     speed [m/s] and altitude above the pad [m] the gains are designed on (interpolated in flight)."""
 
     q_weights: list[Annotated[float, Field(ge=0, le=MAX_LQ_WEIGHT)]] = Field(
-        [0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0], min_length=11, max_length=11
+        [0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0], min_length=11, max_length=11,
+        description="Q's diagonal on (v, w, p, q, r, u_y, u_p, u_r, e_p, e_q, e_r)",
     )
     r_weights: list[Annotated[float, Field(gt=0, le=MAX_LQ_WEIGHT)]] = Field(
-        [100.0, 100.0, 100.0], min_length=3, max_length=3
+        [100.0, 100.0, 100.0], min_length=3, max_length=3, description="R's diagonal on the (yaw, pitch, roll) commands"
     )
-    speeds_mps: list[Annotated[float, Field(gt=0, le=MAX_SPEED_MPS)]] = Field(DEFAULT_SPEEDS_MPS, min_length=2)
-    altitudes_m: list[Annotated[float, Field(ge=0, le=MAX_ALTITUDE_M)]] = Field(DEFAULT_ALTITUDES_M, min_length=1)
-    discretisation: Literal["zoh", "euler"] = "zoh"
-    anti_windup: bool = True
+    speeds_mps: list[Annotated[float, Field(gt=0, le=MAX_SPEED_MPS)]] = Field(
+        DEFAULT_SPEEDS_MPS, min_length=2, description="axial speeds of the design grid, increasing"
+    )
+    altitudes_m: list[Annotated[float, Field(ge=0, le=MAX_ALTITUDE_M)]] = Field(
+        DEFAULT_ALTITUDES_M, min_length=1, description="heights above the pad of the design grid, increasing"
+    )
+    discretisation: Literal["zoh", "euler"] = Field("zoh", description="how the plant is discretised over control_dt_s")
+    anti_windup: bool = Field(True, description="conditional integration after a clipped command")
 
     @field_validator("speeds_mps", "altitudes_m")
     @classmethod
@@ -600,7 +623,7 @@ class GncConfig(_Strict):
     propagated by the gyro; needs [avionics]) or "filters" (the MEKF and the position/velocity Kalman filter
     on the bus, ``filters``; needs [avionics])."""
 
-    navigation: Literal["truth", "sensors", "filters"] = "truth"
+    navigation: Literal["truth", "sensors", "filters"] = Field("truth", description="what the controller reads")
     servo: ServoConfig = ServoConfig()
     guidance: GuidanceConfig = GuidanceConfig()
     control: ControlConfig = ControlConfig()
@@ -618,10 +641,10 @@ class _SensorConfig(_Strict):
     its sampling rate [Hz] (dividing the GNC rate), its latency [s] (a multiple of the GNC period) and a
     switch to turn its errors off (the truth at each sample, on the same schedule)."""
 
-    part: str
-    truth_only: bool = False
-    rate_hz: float = Field(gt=0, le=1.0 / MIN_CONTROL_DT_S)
-    latency_s: float = Field(0.0, ge=0, le=MAX_SENSOR_LATENCY_S)
+    part: str = Field(description="data/sensors/<part>.toml, whose values the other keys override")
+    truth_only: bool = Field(False, description="no errors: the truth at each sample, on the same schedule")
+    rate_hz: float = Field(gt=0, le=1.0 / MIN_CONTROL_DT_S, description="sampling rate, dividing the GNC rate")
+    latency_s: float = Field(0.0, ge=0, le=MAX_SENSOR_LATENCY_S, description="a whole number of GNC periods")
 
 
 class ChannelConfig(_SensorConfig):
@@ -635,16 +658,18 @@ class ChannelConfig(_SensorConfig):
     AXES: ClassVar[int] = 3
     VECTORS: ClassVar[tuple[str, ...]] = ("bias", "bias_std", "scale_factor", "vibration_per_kpa")
 
-    range: list[SensorValue] = Field(min_length=2, max_length=2)
-    lsb: SensorSpread
-    noise_density: SensorSpread | None = None
-    noise_std: SensorSpread | None = None
-    bias: list[SensorValue]
-    bias_std: list[SensorSpread]
-    bias_walk: SensorSpread = 0.0
-    vibration_per_kpa: list[SensorSpread]
-    scale_factor: list[Annotated[float, Field(ge=-0.5, le=0.5)]]
-    scale_factor_std: Annotated[float, Field(ge=0, le=0.1)] = 0.0
+    range: list[SensorValue] = Field(min_length=2, max_length=2, description="[low, high], the sensor's unit")
+    lsb: SensorSpread = Field(description="quantisation step, the sensor's unit (0: none)")
+    noise_density: SensorSpread | None = Field(None, description="white noise density [unit/√Hz] (or noise_std)")
+    noise_std: SensorSpread | None = Field(None, description="white noise per sample [unit] (or noise_density)")
+    bias: list[SensorValue] = Field(description="constant bias per axis [unit]")
+    bias_std: list[SensorSpread] = Field(description="the bias's per-flight spread per axis [unit]")
+    bias_walk: SensorSpread = Field(0.0, description="bias instability as a rate random walk [unit/√s]")
+    vibration_per_kpa: list[SensorSpread] = Field(
+        description="airframe vibration per axis: white noise per sample per kPa of dynamic pressure [unit/kPa]"
+    )
+    scale_factor: list[Annotated[float, Field(ge=-0.5, le=0.5)]] = Field(description="scale-factor error per axis [-]")
+    scale_factor_std: Annotated[float, Field(ge=0, le=0.1)] = Field(0.0, description="its per-flight spread [-]")
 
     @model_validator(mode="before")
     @classmethod
@@ -690,12 +715,21 @@ class InertialConfig(RateChannelConfig):
 
     VECTORS: ClassVar[tuple[str, ...]] = (*ChannelConfig.VECTORS, "cross_axis", "misalignment_deg", "mounting_deg")
 
-    cross_axis: list[Annotated[float, Field(ge=-0.5, le=0.5)]]
-    cross_axis_std: Annotated[float, Field(ge=0, le=0.1)] = 0.0
-    misalignment_deg: list[Annotated[float, Field(ge=-MAX_MISALIGNMENT_DEG, le=MAX_MISALIGNMENT_DEG)]]
-    misalignment_std_deg: Annotated[float, Field(ge=0, le=MAX_MISALIGNMENT_DEG)] = 0.0
-    mounting_deg: list[Direction]
-    position_m: list[Position] | None = Field(None, min_length=3, max_length=3)
+    cross_axis: list[Annotated[float, Field(ge=-0.5, le=0.5)]] = Field(
+        description="cross-axis couplings xy, xz, yx, yz, zx, zy [-]"
+    )
+    cross_axis_std: Annotated[float, Field(ge=0, le=0.1)] = Field(0.0, description="their per-flight spread [-]")
+    misalignment_deg: list[Annotated[float, Field(ge=-MAX_MISALIGNMENT_DEG, le=MAX_MISALIGNMENT_DEG)]] = Field(
+        description="3-2-1 angles about z, y, x, unknown to the avionics"
+    )
+    misalignment_std_deg: Annotated[float, Field(ge=0, le=MAX_MISALIGNMENT_DEG)] = Field(
+        0.0, description="the misalignment's per-flight spread"
+    )
+    mounting_deg: list[Direction] = Field(description="3-2-1 angles from the body frame to the sensor's, known to the avionics")
+    position_m: list[Position] | None = Field(
+        None, min_length=3, max_length=3,
+        description="x in the rocket's coordinates, y, z in the body frame [m] (none: the reference point)",
+    )
 
     @classmethod
     def _size(cls, name: str) -> int:
@@ -708,9 +742,9 @@ class MagnetometerConfig(InertialConfig):
 
     VECTORS: ClassVar[tuple[str, ...]] = (*InertialConfig.VECTORS, "hard_iron", "soft_iron")
 
-    hard_iron: list[SensorValue]
-    hard_iron_std: SensorSpread = 0.0
-    soft_iron: list[Annotated[float, Field(ge=-10, le=10)]]
+    hard_iron: list[SensorValue] = Field(description="the airframe's hard-iron offset per axis [µT]")
+    hard_iron_std: SensorSpread = Field(0.0, description="its per-flight spread [µT]")
+    soft_iron: list[Annotated[float, Field(ge=-10, le=10)]] = Field(description="soft-iron matrix, row by row [-]")
 
     @model_validator(mode="before")
     @classmethod
@@ -741,12 +775,18 @@ class GnssConfig(_SensorConfig):
     sinusoidal position bias A·sin(2πft + φ) [m], [Hz], [deg] (its derivative on the velocity), and the time of
     the first fix [s from t = 0, the rocket on the pad]."""
 
-    position_noise_m: list[Annotated[float, Field(ge=0, le=MAX_LENGTH_KM * 1000)]] = Field(min_length=3, max_length=3)
-    velocity_noise_mps: list[Annotated[float, Field(ge=0, le=MAX_SPEED_MPS)]] = Field(min_length=3, max_length=3)
-    sinusoid_amplitude_m: list[Annotated[float, Field(ge=0, le=MAX_LENGTH_KM * 1000)]] = Field([0.0] * 3, min_length=3, max_length=3)
-    sinusoid_frequency_hz: float = Field(0.0, ge=0, le=1.0)
-    sinusoid_phase_deg: list[Direction] = Field([0.0] * 3, min_length=3, max_length=3)
-    first_fix_s: float = Field(0.0, ge=0, le=MAX_FLIGHT_TIME_S)
+    position_noise_m: list[Annotated[float, Field(ge=0, le=MAX_LENGTH_KM * 1000)]] = Field(
+        min_length=3, max_length=3, description="white noise per fix, north, east, down"
+    )
+    velocity_noise_mps: list[Annotated[float, Field(ge=0, le=MAX_SPEED_MPS)]] = Field(
+        min_length=3, max_length=3, description="white noise per fix, north, east, down"
+    )
+    sinusoid_amplitude_m: list[Annotated[float, Field(ge=0, le=MAX_LENGTH_KM * 1000)]] = Field(
+        [0.0] * 3, min_length=3, max_length=3, description="A of the slow position bias A·sin(2πft + φ), N, E, D"
+    )
+    sinusoid_frequency_hz: float = Field(0.0, ge=0, le=1.0, description="f of the slow position bias")
+    sinusoid_phase_deg: list[Direction] = Field([0.0] * 3, min_length=3, max_length=3, description="φ of the slow position bias, N, E, D")
+    first_fix_s: float = Field(0.0, ge=0, le=MAX_FLIGHT_TIME_S, description="time of the first fix from t = 0, on the pad")
 
 
 SENSOR_CONFIGS: dict[str, type[_SensorConfig]] = {
@@ -764,8 +804,8 @@ class AvionicsConfig(_Strict):
     others the thesis's; a sensor's own ``part`` picks another), with any field overridden in its own table;
     ``truth_only``: every sensor's errors off."""
 
-    part: str = DEFAULT_PART
-    truth_only: bool = False
+    part: str = Field(DEFAULT_PART, description="the part every sensor defaults to (data/sensors/<part>.toml)")
+    truth_only: bool = Field(False, description="every sensor's errors off")
     accelerometer: InertialConfig = Field(default_factory=dict, validate_default=True)
     gyroscope: InertialConfig = Field(default_factory=dict, validate_default=True)
     magnetometer: MagnetometerConfig = Field(default_factory=dict, validate_default=True)
@@ -808,9 +848,9 @@ class AvionicsConfig(_Strict):
 
 class CampaignConfig(_Strict):
     name: str = Field(description=f"a label of 1 to {MAX_NAME_LENGTH} printable characters on one line")
-    description: str = ""
-    n_realizations: int = Field(ge=1, le=MAX_REALIZATIONS)
-    seed: int = Field(ge=0, lt=2**32)
+    description: str = Field("", description="free text")
+    n_realizations: int = Field(ge=1, le=MAX_REALIZATIONS, description="flights in the campaign (-n overrides)")
+    seed: int = Field(ge=0, lt=2**32, description="master seed; realization i draws from fold_in(key(seed), i)")
     rocket: RocketConfig
     site: SiteConfig
     launch: LaunchConfig

@@ -17,13 +17,14 @@ from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
-from .config import DISPERSIBLE_SECTIONS, CampaignConfig, fixed_reason
+from .config import DISPERSIBLE_SECTIONS, CampaignConfig, _SensorConfig, fixed_reason
 
 UNITS = {
-    "_kgm2": "kg·m²", "_m2": "m²", "_mps2": "m/s²", "_mps": "m/s", "_kpa": "kPa", "_kg": "kg", "_deg": "deg",
+    "_deg_s2": "deg/s²", "_deg_s": "deg/s", "_per_kpa": "unit/kPa", "_kgm2": "kg·m²", "_m2": "m²", "_mps2": "m/s²", "_mps": "m/s", "_kpa": "kPa", "_kg": "kg", "_deg": "deg",
     "_hz": "Hz", "_s2": "s²", "_s": "s", "_m": "m", "_pa": "Pa", "_n": "N",
 }  # fmt: skip
-"""Unit of a key from its name's suffix (the project's convention: the unit ends the name), longest first."""
+"""Unit of a key from its name's suffix (the project's convention: the unit ends the name), the first that
+matches (so the longer suffixes first); "unit" is the sensor's own (docs/sensors.md)."""
 INDEX = "<i>"
 """Stands for a list index in a key's path (dispersions write it as a number: ``rocket.geometry.fins.0.span_m``)."""
 
@@ -91,9 +92,10 @@ def _numeric(annotation) -> bool:
                                                                 if not isinstance(a, FieldInfo))  # fmt: skip
 
 
-def _default(field: FieldInfo) -> str:
+def _default(field: FieldInfo, model: type[BaseModel]) -> str:
+    """A field's default as written in TOML; a sensor's required keys come from its part file."""
     if field.is_required():
-        return "required"
+        return "from the part" if issubclass(model, _SensorConfig) else "required"
     value = field.get_default(call_default_factory=True) if field.default is PydanticUndefined else field.default
     if isinstance(value, BaseModel):
         return "its defaults"
@@ -118,10 +120,10 @@ def rows(model: type[BaseModel] = CampaignConfig, prefix: str = "") -> Iterator[
         annotation = field.annotation
         meaning = field.description or ""
         nested = _models(annotation)
-        yield (path, _type(annotation), unit(name), _default(field),
+        yield (path, _type(annotation), unit(name), _default(field, model),
                ", ".join(b for b in (_element_bounds(annotation), _bounds(field.metadata)) if b),
                _dispersible(path, annotation),
-               meaning or (inspect.getdoc(nested[0]) or "").replace("\n", " ") if nested else meaning)  # fmt: skip
+               meaning or inspect.cleandoc(nested[0].__dict__.get("__doc__") or "") if nested else meaning)  # fmt: skip
         for sub in nested:
             origin = typing.get_origin(annotation)
             lists = origin is list or any(typing.get_origin(a) is list for a in typing.get_args(annotation))
