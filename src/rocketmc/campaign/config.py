@@ -444,7 +444,9 @@ class AtmosphereConfig(_Strict):
 
     @field_validator("time_utc")
     @classmethod
-    def _utc(cls, text: str) -> str:
+    def _utc(cls, text: str | None) -> str | None:
+        if text is None:
+            return None
         try:
             time = datetime.fromisoformat(text)
         except ValueError:
