@@ -164,7 +164,7 @@ def test_profile_meets_its_levels_and_continues_with_the_isa_lapse():
 
 
 def test_a_flight_in_an_isa_equal_profile_is_the_isa_flight(lynx_campaign, lynx_params):
-    """The nominal Lynx (Roccaraso, layered wind) in the ISA and in a profile of ISA levels (apogee ~3 km above a
+    """The nominal Lynx (Roccaraso, layered wind) in the ISA and in a profile of ISA levels (apogee ~1.6 km above a
     1.3 km pad, inside the troposphere's one layer): apogee and impact agree to 1e-9 relative (the profile's
     air equals the ISA's to ~1e-15; the rest is the flight's sensitivity to it)."""
     run = jax.jit(lambda p: simulate_one(p, sim_settings(lynx_campaign))[0])
@@ -175,7 +175,7 @@ def test_a_flight_in_an_isa_equal_profile_is_the_isa_flight(lynx_campaign, lynx_
     distance = math.hypot(want["impact_north_m"], want["impact_east_m"])
     for name in ("impact_north_m", "impact_east_m"):
         assert abs(got[name] - want[name]) <= 1e-9 * distance, name
-    assert float(want["apogee_agl_m"]) > 2000.0
+    assert float(want["apogee_agl_m"]) > 1000.0
 
 
 def test_the_day_s_wind_turned_and_scaled(tmp_path):
