@@ -1194,8 +1194,11 @@ def sensor_spreads(config: CampaignConfig) -> dict[str, Dispersion]:
 
 
 def _nominal_values(config: CampaignConfig) -> dict[str, float]:
-    """Every number of the dispersible sections by dotted path (``Campaign.nominal``)."""
+    """Every number of the dispersible sections by dotted path (``Campaign.nominal``); with an
+    [environment.atmosphere], none of [environment.wind]'s (its file brings the wind)."""
     dump = config.model_dump()
+    if config.environment.atmosphere is not None:
+        del dump["environment"]["wind"]
     return {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
 
 
