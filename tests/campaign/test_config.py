@@ -30,6 +30,7 @@ DEFAULTS = {
     "rocket.geometry.fins.*.first_panel_deg": 0.0, "rocket.geometry.fins.*.thickness_m": 0.005,
     "rocket.geometry.canards.cant_deg": 0.0, "rocket.geometry.canards.first_panel_deg": 0.0,
     "rocket.parachutes.*.opening_time_s": 0.0, "environment.wind.speed_scale": 1.0,
+    "environment.atmosphere.wind_rotation_deg": 0.0, "environment.atmosphere.wind_scale": 1.0,
 }  # fmt: skip
 PARTS = ROCKETS.parent / "sensors"
 SENSOR_DEFAULTS = {

@@ -11,6 +11,7 @@ import dataclasses
 import hashlib
 import math
 import tomllib
+from datetime import datetime, timezone
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
@@ -27,6 +28,7 @@ from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thr
 from ..env.atmosphere import G0
 from ..errors import RocketmcError
 from ..gnc.design import Schedule
+from ..env.weather import Weather, WeatherError, read_weather
 from ..env.wind import POWER_LAW_FLOOR_M, read_wind_profile
 from ..math.table import Table
 from ..sensors.parts import load_part, part_names
@@ -440,11 +442,52 @@ class TurbulenceConfig(_Strict):
     w20_mps: WindSpeed | None = Field(None, description="wind at 20 ft for the low-altitude intensities")
 
 
+class AtmosphereConfig(_Strict):
+    """The day's atmosphere from a file (docs/weather.md): its temperature, pressure and wind against height give
+    every flight's density, speed of sound, pressure and mean wind, in place of the standard atmosphere and of
+    [environment.wind]; the day's wind profile can be turned and scaled (both dispersible)."""
+
+    file: str = Field(description="a sounding (University of Wyoming text list, or CSV) or an ERA5/GFS netCDF file "
+                                  "on pressure levels, beside the campaign or in the package's data/weather")  # fmt: skip
+    time_utc: str | None = Field(None, description="netCDF only, required there: the launch time in UTC, ISO 8601 "
+                                                   "('2023-10-13T12:00:00Z'); the file's nearest time is used")  # fmt: skip
+    grid: Literal["bilinear", "nearest"] | None = Field(
+        None, description="netCDF only: interpolate between the four grid points around the site (the default) or "
+                          "take the nearest one")  # fmt: skip
+    wind_rotation_deg: float = Field(0.0, ge=-360, le=360, description="turns the day's wind clockwise: added to "
+                                                                       "every level's from-direction [deg]")  # fmt: skip
+    wind_scale: float = Field(1.0, ge=0, le=MAX_SCALE, description="multiplies every level's wind speed")
+
+    @field_validator("time_utc")
+    @classmethod
+    def _utc(cls, text: str | None) -> str | None:
+        if text is None:
+            return None
+        try:
+            time = datetime.fromisoformat(text)
+        except ValueError:
+            raise ValueError("expected an ISO 8601 date and time, e.g. '2023-10-13T12:00:00Z'") from None
+        if time.utcoffset() != timezone.utc.utcoffset(None):
+            raise ValueError("expected a time in UTC, ending in 'Z' (or '+00:00')")
+        return text
+
+
 class EnvironmentConfig(_Strict):
     """The air the rocket flies through: mean wind and turbulence."""
 
     wind: WindConfig = WindConfig()
     turbulence: TurbulenceConfig | None = None
+    atmosphere: AtmosphereConfig | None = Field(
+        None, description="the day's atmosphere and wind from a file; None: the standard atmosphere and "
+                          "[environment.wind]")  # fmt: skip
+
+    @model_validator(mode="after")
+    def _one_wind(self):
+        if self.atmosphere is not None and self.wind != WindConfig():
+            raise ValueError("[environment.wind] and [environment.atmosphere] both give the wind: the atmosphere's "
+                             "file brings its own (turn it with wind_rotation_deg, scale it with wind_scale); "
+                             "remove [environment.wind]")  # fmt: skip
+        return self
 
 
 class Dispersion(_Strict):
@@ -890,6 +933,7 @@ class Campaign:
     files: dict[str, str] = dataclasses.field(default_factory=dict)
     gnc_schedule: Schedule | None = None
     gnc_inputs: DesignInputs | None = None
+    weather: Weather | None = None
 
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
@@ -1066,6 +1110,9 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
         field = f"dispersions.{path}"
         if (reason := fixed_reason(path)) is not None:
             raise ConfigError(f"{field}: {reason}")
+        if path.startswith("environment.wind.") and config.environment.atmosphere is not None:
+            raise ConfigError(f"{field}: the wind is environment.atmosphere's; disperse "
+                              "environment.atmosphere.wind_rotation_deg or wind_scale instead")  # fmt: skip
         if path not in nominal:
             raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
                               f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
@@ -1116,7 +1163,8 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
     _check_dispersions(config, nominal)
     aero = _aero_model(config.rocket, base_dir)
     return _with_gains(Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir,
-                                _wind_profile(config, base_dir), _file_digests(config, base_dir)))  # fmt: skip
+                                _wind_profile(config, base_dir), _file_digests(config, base_dir),
+                                weather=_weather(config, base_dir)))  # fmt: skip
 
 
 def sensor_ticks(config: CampaignConfig, seconds: float, field: str) -> int:
@@ -1233,8 +1281,11 @@ def sensor_spreads(config: CampaignConfig) -> dict[str, Dispersion]:
 
 
 def _nominal_values(config: CampaignConfig) -> dict[str, float]:
-    """Every number of the dispersible sections by dotted path (``Campaign.nominal``)."""
+    """Every number of the dispersible sections by dotted path (``Campaign.nominal``); with an
+    [environment.atmosphere], none of [environment.wind]'s (its file brings the wind)."""
     dump = config.model_dump()
+    if config.environment.atmosphere is not None:
+        del dump["environment"]["wind"]
     return {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
 
 
@@ -1246,6 +1297,8 @@ def _file_digests(config: CampaignConfig, base_dir: Path) -> dict[str, str]:
         named["rocket.aero.tables"] = (aero.tables, "aero")
     if wind.model == "profile":
         named["environment.wind.file"] = (wind.file, "wind")
+    if config.environment.atmosphere is not None:
+        named["environment.atmosphere.file"] = (config.environment.atmosphere.file, "weather")
     return {
         field: hashlib.sha256(_resolve_data_file(name, base_dir, folder, field).read_bytes()).hexdigest()
         for field, (name, folder) in named.items()
@@ -1265,6 +1318,23 @@ def _wind_profile(config: CampaignConfig, base_dir: Path) -> tuple[np.ndarray, n
         raise ConfigError(f"environment.wind.file: {path}: speed_mps reaches {speed.max():g}, "
                           f"above {MAX_WIND_MPS:g} m/s")  # fmt: skip
     return altitude, speed, from_rad
+
+
+def _weather(config: CampaignConfig, base_dir: Path) -> Weather | None:
+    """The day's atmosphere at the site (``env.weather.read_weather``), None without [environment.atmosphere]."""
+    atmosphere, field = config.environment.atmosphere, "environment.atmosphere"
+    if atmosphere is None:
+        return None
+    path = _resolve_data_file(atmosphere.file, base_dir, "weather", f"{field}.file")
+    time = None if atmosphere.time_utc is None else datetime.fromisoformat(atmosphere.time_utc)
+    try:
+        weather = read_weather(path, config.site.latitude_deg, config.site.longitude_deg, time, atmosphere.grid)
+    except WeatherError as err:
+        raise ConfigError(f"{field}.{err.field}: {err}") from None
+    if weather.speed_mps.max() > MAX_WIND_MPS:
+        raise ConfigError(f"{field}.file: {path}: the wind reaches {weather.speed_mps.max():g} m/s, "
+                          f"above {MAX_WIND_MPS:g} m/s")  # fmt: skip
+    return weather
 
 
 def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:

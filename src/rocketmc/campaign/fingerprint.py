@@ -28,10 +28,12 @@ PACKAGES = ("jax", "jaxlib", "numpy", "scipy")
 
 def data_digest(campaign: Campaign) -> str:
     """SHA-256 of every array the campaign read or built from files: its thrust curve, its
-    aerodynamic model's tables and scalars, its wind profile, and the LQI gain schedule designed from
-    them (dtype, shape and bytes of each)."""
+    aerodynamic model's tables and scalars, its wind profile, the day's atmosphere (its levels' arrays), and the
+    LQI gain schedule designed from them (dtype, shape and bytes of each)."""
     digest = hashlib.sha256()
-    tree = (campaign.thrust_time_s, campaign.thrust_n, campaign.aero, campaign.wind_profile, campaign.gnc_schedule)
+    weather = None if campaign.weather is None else campaign.weather[:5]
+    tree = (campaign.thrust_time_s, campaign.thrust_n, campaign.aero, campaign.wind_profile, campaign.gnc_schedule,
+            weather)  # fmt: skip
     digest.update(str(jax.tree_util.tree_structure(tree)).encode())
     for leaf in jax.tree_util.tree_leaves(tree):
         array = np.ascontiguousarray(leaf)

@@ -23,7 +23,7 @@ from threadpoolctl import threadpool_limits
 from ..aero.model import LinearAero, linear_derivatives, simplify
 from ..dynamics.propulsion import propellant_mass, thrust
 from ..dynamics.rigid_body import MassProperties
-from ..env.atmosphere import G0, isa
+from ..env.atmosphere import G0, AtmosphereProfile, air
 from ..gnc.design import PlantPoint, Schedule, gain_schedule
 from ..sim.flight import mass_properties
 from ..sim.params import FlightParams
@@ -33,20 +33,21 @@ from .model import nominal_params
 ESTIMATE_DT_S = 0.01
 """Step of the point-mass estimate [s]: Lynx's window speeds are within 0.3 % of a step ten times smaller."""
 ESTIMATE_HEIGHTS_M = np.linspace(0.0, 50_000.0, 1001)
-"""Heights above the pad [m] the estimate tabulates the ISA on: every 50 m to 50 km (the ISA ends at 47 km)."""
+"""Heights above the pad [m] the estimate tabulates the air on: every 50 m to 50 km (the ISA ends at 47 km)."""
 
 
 class DesignInputs(NamedTuple):
     """What the gains are designed from: aero, the campaign's model in its simplified form; mass, the
     nominal rocket at burnout (mass [kg], CG body x [m], inertia [kg·m²]); omega_a, the servo bandwidth
     1/τ [rad/s]; speeds [m/s] and altitudes_agl [m above the pad], the nominal flight's range inside the
-    guidance window (point-mass estimate, ``window_envelope``)."""
+    guidance window (point-mass estimate, ``window_envelope``); atmosphere: the day's air (None: the ISA)."""
 
     aero: LinearAero
     mass: MassProperties
     omega_a: float
     speeds: tuple[float, float]
     altitudes_agl: tuple[float, float]
+    atmosphere: AtmosphereProfile | None = None
 
 
 def design_inputs(campaign: Campaign) -> DesignInputs:
@@ -65,28 +66,30 @@ def design_inputs(campaign: Campaign) -> DesignInputs:
     guidance = campaign.config.gnc.guidance
     speeds, altitudes = window_envelope(params, aero, *map(np.asarray, arrays), guidance.window_start_s,
                                         guidance.window_end_s)  # fmt: skip
-    return DesignInputs(aero, mass, 1.0 / campaign.config.gnc.servo.time_constant_s, speeds, altitudes)
+    return DesignInputs(aero, mass, 1.0 / campaign.config.gnc.servo.time_constant_s, speeds, altitudes,
+                        params.environment.atmosphere)  # fmt: skip
 
 
 @jax.jit
 def _nominal_arrays(params: FlightParams, times, heights):
     """The nominal rocket's mass properties at burnout; thrust [N] and propellant mass [kg] at simulation
-    ``times`` [s]; ISA density [kg/m³] and speed of sound [m/s] at ``heights`` above the pad [m]. One
+    ``times`` [s]; the air's density [kg/m³] and speed of sound [m/s] at ``heights`` above the pad [m]. One
     compilation (eagerly, XLA compiles each operation apart: seconds in a fresh process)."""
     motor = params.rocket.motor
-    air = isa(params.environment.site_altitude_m + heights)
+    air = params.environment.air(params.environment.site_altitude_m + heights)
     return (mass_properties(params, motor.ignition_time_s + motor.burn_time_s), thrust(motor, times),
             propellant_mass(motor, times), air.density, air.speed_of_sound)  # fmt: skip
 
 
 def plant_point(
-    aero: LinearAero, mass: MassProperties, speed: float, altitude_msl: float, omega_a: float
-) -> PlantPoint:
+    aero: LinearAero, mass: MassProperties, speed: float, altitude_msl: float, omega_a: float,
+    atmosphere: AtmosphereProfile | None = None,
+) -> PlantPoint:  # fmt: skip
     """GNC.md §5's plant at axial speed ``speed`` [m/s] and ``altitude_msl`` [m]: the coefficients of
-    ``aero`` at that Mach number and altitude (ISA), the moments moved from its reference to the CG of
-    ``mass``, the force damping halved to PlantPoint's per ω·d/V."""
-    air = isa(altitude_msl)
-    c = linear_derivatives(aero, speed / float(air.speed_of_sound), altitude_msl)
+    ``aero`` at that Mach number and altitude (in ``atmosphere``, the ISA if None), the moments moved from
+    its reference to the CG of ``mass``, the force damping halved to PlantPoint's per ω·d/V."""
+    air_there = air(atmosphere, altitude_msl)
+    c = linear_derivatives(aero, speed / float(air_there.speed_of_sound), altitude_msl)
     d = float(aero.reference_length_m)
     # About the CG: M_cg = M_ref + (a, 0, 0) × q̄S(−CA, CY, −CN), a = x_ref − x_cg (forward), so
     # Cm gains (a/d)·CN and Cn gains (a/d)·CY, term by term.
@@ -100,7 +103,7 @@ def plant_point(
         cn_yaw_beta=-c["Cma"] - arm * c["CNa"], cn_r=c["Cnr"] + arm * c["CYr"],
         cn_yaw_delta=c["Cn_yaw"] + arm * c["CY_yaw"],
         mass=float(mass.mass), ixx=float(mass.ixx), iyy=float(mass.iyy), area=float(aero.reference_area_m2),
-        diameter=d, speed=float(speed), density=float(air.density), omega_a=omega_a,
+        diameter=d, speed=float(speed), density=float(air_there.density), omega_a=omega_a,
     )  # fmt: skip
 
 
@@ -110,7 +113,7 @@ def window_envelope(params: FlightParams, aero: LinearAero, thrust_n, propellant
     estimated: a point mass up the rail, then turning under gravity (thrust and drag along the
     velocity), with the thrust [N] and propellant [kg] every ESTIMATE_DT_S from t = 0 to burnout,
     the zero-lift drag drag_scale·CA0(Mach) at the pad's altitude (no power-on change, no airbrakes)
-    and the ISA's density and speed of sound at ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for
+    and the air's density and speed of sound at ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for
     Lynx. ConfigError if the flight is not in the air then."""
     site, motor = float(params.environment.site_altitude_m), params.rocket.motor
     heights = ESTIMATE_HEIGHTS_M
@@ -183,7 +186,8 @@ def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
         # on 2 busy cores), and the gains (in the set-up's fingerprint) are the same bits on any machine.
         with threadpool_limits(1):
             return gain_schedule(
-                lambda speed, altitude: plant_point(inputs.aero, inputs.mass, speed, altitude, inputs.omega_a),
+                lambda speed, altitude: plant_point(inputs.aero, inputs.mass, speed, altitude, inputs.omega_a,
+                                                    inputs.atmosphere),
                 control.speeds_mps,
                 campaign.config.site.altitude_m + np.asarray(control.altitudes_m),
                 dt=campaign.config.simulation.control_dt_s,

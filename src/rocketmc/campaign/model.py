@@ -19,6 +19,8 @@ from ..dynamics.propulsion import cumulative_impulse
 from ..dynamics.rigid_body import combine_on_axis
 from ..dynamics.servo import ServoParams
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
+from ..env.atmosphere import AtmosphereProfile
+from ..env.weather import geometric_altitude
 from ..gnc.control import GAIN_NAMES, GncParams
 from ..gnc.attitude_filter import AttitudeTuning
 from ..gnc.guidance import GuidanceParams
@@ -136,6 +138,7 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
         site_altitude_m=jnp.asarray(cfg.site.altitude_m, dtype=float),
         wind=_wind(campaign, v),
         turbulence=_turbulence(campaign, v, key),
+        atmosphere=_atmosphere(campaign),
     )
     return FlightParams(rocket, launch, environment, _gnc(campaign, v), _avionics(campaign, v, key, body_x, aero.n_canards))
 
@@ -277,8 +280,24 @@ def _avionics(campaign: Campaign, v: Mapping, key, body_x, n_canards: int) -> Av
                     gnss, _channel(campaign, v, "canard_feedback") if n_canards else None, keys)  # fmt: skip
 
 
+def _atmosphere(campaign: Campaign) -> AtmosphereProfile | None:
+    """The day's atmosphere of [environment.atmosphere] (None without: the ISA)."""
+    weather = campaign.weather
+    if weather is None:
+        return None
+    return AtmosphereProfile(jnp.asarray(weather.geopotential_height_m), jnp.asarray(weather.temperature_k),
+                             jnp.log(jnp.asarray(weather.pressure_pa)))  # fmt: skip
+
+
 def _wind(campaign: Campaign, v: Mapping):
-    """The mean wind of the campaign's model from the (possibly drawn) values ``v``."""
+    """The mean wind of the campaign's model from the (possibly drawn) values ``v``: [environment.atmosphere]'s
+    profile when there is one (its levels' geometric heights above the pad, turned by wind_rotation_deg and
+    scaled by wind_scale), else [environment.wind]'s."""
+    weather, a = campaign.weather, "environment.atmosphere"
+    if weather is not None:
+        height = geometric_altitude(weather.geopotential_height_m) - campaign.config.site.altitude_m
+        return WindProfile.from_speed_direction(height, jnp.asarray(weather.speed_mps) * v[f"{a}.wind_scale"],
+                                                weather.from_rad + jnp.deg2rad(v[f"{a}.wind_rotation_deg"]))  # fmt: skip
     config, w = campaign.config.environment.wind, "environment.wind"
     if config.model == "layers":
         n = len(config.layers)

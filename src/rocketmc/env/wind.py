@@ -102,13 +102,11 @@ class PowerLawWind:
         return []
 
 
-def read_wind_profile(path, site_altitude_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(altitude above ground [m], speed [m/s], from-direction [rad]) of a measured profile, on the host.
-
-    The CSV (``#`` comments allowed) has a header naming ``altitude_agl_m`` or ``altitude_msl_m``
-    (the latter made relative to ``site_altitude_m``), ``speed_mps`` and ``from_deg``; altitudes strictly
-    increasing. ``ValueError`` naming the file and what is wrong, also for a file that is not text.
-    """
+def read_csv_columns(path, columns: tuple[tuple[str, ...], ...]) -> tuple[list[str], np.ndarray]:
+    """The columns of a CSV file (``#`` comments allowed) as floats, on the host: ``columns`` lists, for each
+    column read, the header names it may have (exactly one present). Returns the names found and an array
+    (rows, columns) of at least 2 rows of finite numbers. ``ValueError`` naming the file and what is wrong,
+    also for a file that is not text."""
     try:
         with Path(path).open(newline="", encoding="utf-8-sig") as f:  # -sig: spreadsheets often start with a BOM
             reader = csv.DictReader(line for line in f if line.strip() and not line.lstrip().startswith("#"))
@@ -118,22 +116,34 @@ def read_wind_profile(path, site_altitude_m: float) -> tuple[np.ndarray, np.ndar
         raise ValueError(f"{path}: not a UTF-8 text file") from None
     except csv.Error as err:  # e.g. a NUL byte
         raise ValueError(f"{path}: not a readable CSV file ({err})") from None
-    altitude_columns = [c for c in ("altitude_agl_m", "altitude_msl_m") if c in header]
-    if len(altitude_columns) != 1 or not {"speed_mps", "from_deg"} <= set(header):
-        raise ValueError(f"{path}: expected columns altitude_agl_m (or altitude_msl_m), speed_mps and from_deg, "
+    found = [[c for c in names if c in header] for names in columns]
+    if any(len(names) != 1 for names in found):
+        wanted = [names[0] + "".join(f" (or {c})" for c in names[1:]) for names in columns]
+        raise ValueError(f"{path}: expected columns {', '.join(wanted[:-1])} and {wanted[-1]}, "
                          f"found {', '.join(header) or 'none'}")  # fmt: skip
-    columns = [altitude_columns[0], "speed_mps", "from_deg"]
+    names = [c for c, in found]
     try:
-        values = np.array([[float(row[c]) for c in columns] for row in rows])
+        values = np.array([[float(row[c]) for c in names] for row in rows])
     except (TypeError, ValueError):
-        raise ValueError(f"{path}: every row needs numbers in {', '.join(columns)}") from None
+        raise ValueError(f"{path}: every row needs numbers in {', '.join(names)}") from None
     if len(values) < 2 or not np.all(np.isfinite(values)):
-        raise ValueError(f"{path}: needs at least 2 rows of finite numbers in {', '.join(columns)}")
+        raise ValueError(f"{path}: needs at least 2 rows of finite numbers in {', '.join(names)}")
+    return names, values
+
+
+def read_wind_profile(path, site_altitude_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(altitude above ground [m], speed [m/s], from-direction [rad]) of a measured profile, on the host.
+
+    The CSV (``#`` comments allowed) has a header naming ``altitude_agl_m`` or ``altitude_msl_m``
+    (the latter made relative to ``site_altitude_m``), ``speed_mps`` and ``from_deg``; altitudes strictly
+    increasing. ``ValueError`` naming the file and what is wrong, also for a file that is not text.
+    """
+    names, values = read_csv_columns(path, (("altitude_agl_m", "altitude_msl_m"), ("speed_mps",), ("from_deg",)))
     altitude, speed, from_deg = values.T
-    if altitude_columns[0] == "altitude_msl_m":
+    if names[0] == "altitude_msl_m":
         altitude = altitude - site_altitude_m
     if not np.all(np.diff(altitude) > 0):
-        raise ValueError(f"{path}: {altitude_columns[0]} must be strictly increasing")
+        raise ValueError(f"{path}: {names[0]} must be strictly increasing")
     if np.any(speed < 0):
         raise ValueError(f"{path}: speed_mps must not be negative")
     return altitude, speed, np.deg2rad(from_deg)

@@ -19,7 +19,7 @@ import numpy as np
 from jax import lax
 from jax.extend.random import threefry2x32_p
 
-from ..env.atmosphere import G0, isa
+from ..env.atmosphere import G0
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass, static_field
 from .errors import Channel, ChannelState, initial_channel, sample
@@ -247,10 +247,11 @@ def _written(av: Avionics, state: AvionicsState, read: dict, qbar) -> AvionicsSt
 
 
 def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_nb: Quat, omega_b: Vec3,
-          deflections, site_altitude_m, enabled, noise) -> AvionicsState:  # fmt: skip
+          deflections, environment, enabled, noise) -> AvionicsState:  # fmt: skip
     """Every sensor but the accelerometer at tick ``tick``, time t [s], from the truth: position r_n [m] and
     velocity v_n [m/s] of the CG (NED), attitude q_nb, body rates omega_b [rad/s], the servos' deflections
-    (n_canards,) [rad]; enabled: the sensors sample (False in the long descent periods); noise: this tick's row of
+    (n_canards,) [rad]; environment: the flight's ``sim.params.Environment`` (the barometer reads its air's
+    pressure); enabled: the sensors sample (False in the long descent periods); noise: this tick's row of
     ``avionics_noise``."""
     mag = av.magnetometer
     field_s = _apply(mag.sensor.rotation, q_nb.rotate_inverse(Vec3(*(mag.field_n[i] for i in range(3)))))
@@ -262,7 +263,7 @@ def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_n
     truths = {
         "gyroscope": (av.gyroscope.channel, _apply(av.gyroscope.rotation, omega_b)),
         "magnetometer": (mag.sensor.channel, _apply(mag.soft_iron, Vec3(*field_s)) + mag.hard_iron),
-        "barometer": (av.barometer, isa(site_altitude_m - r_n.z).pressure[None]),
+        "barometer": (av.barometer, environment.air(environment.site_altitude_m - r_n.z).pressure[None]),
         "gnss": (gnss.channel, fix),
         "canard_feedback": (av.canard_feedback, deflections),
     }  # fmt: skip

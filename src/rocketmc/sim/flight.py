@@ -21,7 +21,7 @@ from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
 from ..dynamics.servo import deflection_at, end_of_period
 from ..env import (
-    G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, isa, turbulence_noise, turbulence_scales,
+    G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, turbulence_noise, turbulence_scales,
 )  # fmt: skip
 from ..env.atmosphere import MAX_ALTITUDE_M
 from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, truth
@@ -146,7 +146,7 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     mass = mass_properties(p, t)
     altitude = -body.r_n.z
     altitude_msl = env.site_altitude_m + altitude
-    atmosphere = isa(altitude_msl)
+    atmosphere = env.air(altitude_msl)
     wind_n = env.wind.velocity_n(altitude) + gust_n
     q_nb, omega_b = body.q_nb, body.omega_b
     air = air_data(q_nb.rotate_inverse(body.v_n - wind_n), atmosphere, altitude_msl)
@@ -452,7 +452,7 @@ def _sensed(p: FlightParams, state: FlightState, deflections, sensing, noise: St
         return state
     body = _at_rest_once_landed(state)
     avionics = sense(p.avionics, state.avionics, state.tick, state.t, body.r_n, body.v_n, body.q_nb, body.omega_b,
-                     deflections, p.environment.site_altitude_m, sensing, noise.avionics)  # fmt: skip
+                     deflections, p.environment, sensing, noise.avionics)  # fmt: skip
     return dataclasses.replace(state, avionics=avionics)
 
 

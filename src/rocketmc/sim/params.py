@@ -11,6 +11,7 @@ from ..dynamics import Motor, Parachute
 from ..gnc.control import GncParams
 from ..sensors.avionics import Avionics
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
+from ..env.atmosphere import AtmosphereProfile, AtmosphereState, air
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass
 
@@ -59,11 +60,17 @@ class Launch:
 @pytree_dataclass
 class Environment:
     """site_altitude_m: pad altitude above mean sea level [m]; wind: the mean wind; turbulence:
-    Dryden gusts added to it (None: no turbulence, and no cost)."""
+    Dryden gusts added to it (None: no turbulence, and no cost); atmosphere: the day's (None: the ISA, and
+    no cost)."""
 
     site_altitude_m: jnp.ndarray
     wind: WindLayers | WindProfile | PowerLawWind
     turbulence: Turbulence | None = None
+    atmosphere: AtmosphereProfile | None = None
+
+    def air(self, altitude_msl) -> AtmosphereState:
+        """The air at a geometric altitude above mean sea level [m]."""
+        return air(self.atmosphere, altitude_msl)
 
 
 @pytree_dataclass
