@@ -349,6 +349,17 @@ def control_period(p: FlightParams, settings: SimSettings, state: FlightState):
     return jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
 
 
+def period_gust(p: FlightParams, state: FlightState):
+    """The mean wind at the period start's height [m/s, NED], the turbulence's ``turbulence_scales`` there (None
+    without turbulence) and the gust held over the period starting at ``state`` [m/s, NED]."""
+    altitude = -state.body.r_n.z
+    mean_wind_n = p.environment.wind.velocity_n(altitude)
+    if p.environment.turbulence is None:
+        return mean_wind_n, None, Vec3.zeros(state.t)
+    scales = turbulence_scales(p.environment.turbulence, altitude)
+    return mean_wind_n, scales, gust_n(state.turbulence, scales, mean_wind_n, state.body.q_nb)
+
+
 def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None,
     first_stage: bool = False,
@@ -364,12 +375,7 @@ def control_step(
     """
     h = period / settings.substeps
     turbulence = p.environment.turbulence
-    altitude = -state.body.r_n.z
-    mean_wind_n = p.environment.wind.velocity_n(altitude)
-    gust = Vec3.zeros(state.t)
-    if turbulence is not None:
-        scales = turbulence_scales(turbulence, altitude)
-        gust = gust_n(state.turbulence, scales, mean_wind_n, state.body.q_nb)
+    mean_wind_n, scales, gust = period_gust(p, state)
 
     def rhs(t, y, events):
         d_body, diag = derivatives(t, y, p, deflections(t), gust, events)
