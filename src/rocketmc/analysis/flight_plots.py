@@ -13,6 +13,7 @@ from .flight_record import FlightRecord, ascent, events
 
 FIGURES = ("path_3d.png", "altitude_speed.png", "angles_of_attack.png", "stability_margin.png")
 _EVENT_COLORS = {"rail exit": "tab:gray", "burnout": "tab:red", "apogee": "tab:green", "impact": "black"}
+_CHUTE_COLORS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive")
 
 
 def _save(fig: Figure, path: Path) -> None:
@@ -23,10 +24,11 @@ def _save(fig: Figure, path: Path) -> None:
 
 def _events(axes, record: FlightRecord, until: float | None = None) -> None:
     """Dashed vertical lines at the events (up to ``until`` [s]), labelled in the first axes' legend."""
+    chute_colors = iter(_CHUTE_COLORS * len(record.campaign.config.rocket.parachutes))
     for name, t in events(record):
+        color = _EVENT_COLORS.get(name) or next(chute_colors)  # the parachutes' in the order they deploy
         if until is not None and t > until:
             continue
-        color = _EVENT_COLORS.get(name, "tab:purple" if "drogue" in name else "tab:brown")
         for k, ax in enumerate(axes):
             ax.axvline(t, color=color, linestyle="--", linewidth=0.8, label=f"{name} ({t:.2f} s)" if k == 0 else None)
 
@@ -78,9 +80,8 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     ax_alt.set_title(f"{record.label}: altitude and speed")
     _save(fig, paths[1])
 
-    up = ascent(record)
-    end = m["apogee_time_s"] + 2.0 if not np.isnan(m["apogee_time_s"]) else t[-1]
-    shown = s[(s["time"] >= m["rail_exit_time_s"] - 0.5) & (s["time"] <= end)]
+    up = shown = ascent(record)  # off the rail (slow, so large angles in a wind) and before the canopies
+    end = m["apogee_time_s"]
     fig = Figure(figsize=(9.0, 7.5))
     ax_angles, ax_mach = fig.subplots(2, 1, sharex=True)
     ax_angles.plot(shown["time"], shown["alpha"], label="angle of attack α")
@@ -99,7 +100,7 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     ax_mach.legend(lines, [h.get_label() for h in lines], fontsize="small", loc="upper right")
     for a in (ax_angles, ax_mach):
         a.grid(alpha=0.3)
-    ax_angles.set_title(f"{record.label}: angles of attack, rail exit to apogee + 2 s\n"
+    ax_angles.set_title(f"{record.label}: angles of attack, rail exit to apogee\n"
                         "(air-relative velocity: mean wind and gust)")  # fmt: skip
     _save(fig, paths[2])
 
