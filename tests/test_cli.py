@@ -10,6 +10,7 @@ import h5py
 import numpy as np
 import pytest
 
+from rocketmc.analysis.flight_plots import FIGURES as FLY_FIGURES
 from rocketmc.cli import main
 
 CAMPAIGNS = Path(__file__).parents[1] / "campaigns"
@@ -165,7 +166,7 @@ def test_help_matches_the_readme(capsys):
     added without the README saying so fails) and the same choices where the README lists them."""
     documented = _readme_commands()
     assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
-                               ("sensors", "simulate"), ("navigate",), ("validate",), ("bench",)}  # fmt: skip
+                               ("sensors", "simulate"), ("navigate",), ("fly",), ("validate",), ("bench",)}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]
@@ -222,3 +223,33 @@ def test_old_spellings_still_parse_as_the_new(old, new):
     from rocketmc.cli import build_parser
 
     assert vars(build_parser().parse_args(old)) == vars(build_parser().parse_args(new))
+
+
+def test_fly(tmp_path, capsys):
+    """One realization's time series as HDF5 with units, its figures and KML path; the summary is the flight's."""
+    out, kml, figures = tmp_path / "flight.h5", tmp_path / "path.kml", tmp_path / "figures"
+    args = ["--realization", "2", "--out", str(out), "--kml", str(kml), "--plot-dir", str(figures), "--quiet"]
+    assert main(["fly", str(CAMPAIGNS / "lynx_ballistic.toml"), *args]) == 0
+    printed = capsys.readouterr().out
+    assert printed.startswith("lynx_ballistic, realization 2: ok") and "apogee" in printed and "impact" in printed
+    with h5py.File(out) as f:
+        assert f.attrs["realization"] == 2 and f.attrs["status"] == 0
+        assert f["series/altitude"].attrs["unit"] == "m" and f["series/static_margin"].attrs["unit"] == "cal"
+        apogee = f["summary/apogee_agl_m"][()]
+        assert f"{apogee:.1f} m above the pad" in printed
+        assert 0.0 <= apogee - f["series/altitude"][:].max() < 1e-3  # the highest sample within h/2 of apogee
+        assert f["series/time"].shape == f["series/phase"].shape and f["series/phase"][-1] == b"landed"
+    assert "<LineString>" in kml.read_text() and "apogee" in kml.read_text()
+    assert sorted(p.name for p in figures.iterdir()) == sorted(FLY_FIGURES)
+
+
+def test_fly_bad_input_exit_2(tmp_path, capsys):
+    campaign = str(CAMPAIGNS / "lynx_ballistic.toml")
+    assert main(["fly", campaign, "--realization", "1000"]) == 2
+    assert main(["fly", campaign, "--out", str(tmp_path / "flight.txt")]) == 2
+    assert main(["fly", campaign, "--kml", str(tmp_path / "path.geojson")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 3 and all(line.startswith("rocketmc: error:") for line in lines), lines
+    assert "--realization 1000" in lines[0] and "(0 to 999)" in lines[0]
+    assert "--out" in lines[1] and ".csv or .h5" in lines[1] and "--kml" in lines[2]
+    assert not list(tmp_path.iterdir())

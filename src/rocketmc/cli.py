@@ -1,7 +1,8 @@
 """The ``rocketmc`` command line: ``run`` a campaign, ``report`` on its result file, ``compare`` the
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
 a campaign, ``sensors simulate``: one realization's sensor log, ``navigate``: the navigation filters replayed on
-a sensor log, ``validate`` the simulation against a real flight, ``bench`` this machine."""
+a sensor log, ``fly``: one flight's time series, ``validate`` the simulation against a real flight, ``bench`` this
+machine."""
 
 from __future__ import annotations
 
@@ -398,6 +399,35 @@ def _navigate(args) -> int:
     return 0
 
 
+def _fly_one(args) -> int:
+    from .analysis.flight_plots import plot_flight
+    from .analysis.flight_record import (
+        OUT_SUFFIXES, check_realization, flight_record, format_record, write_kml, write_series,
+    )  # fmt: skip
+
+    out = None if args.out is None else _refuse_existing("--out", _output_file("--out", args.out, OUT_SUFFIXES), args.force)
+    kml = None if args.kml is None else _refuse_existing("--kml", _output_file("--kml", args.kml, (".kml",)), args.force)
+    campaign = _campaign(args.campaign)
+    try:
+        check_realization(campaign, args.realization)
+    except ValueError as e:
+        raise RocketmcError(str(e)) from None
+    if args.plot_dir:  # before the flight: a folder that cannot be made is said at once
+        Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
+    say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    which = "the nominal flight" if args.realization is None else f"realization {args.realization}"
+    say(f"{campaign.config.name}: {which} (compiling, then flying)")
+    record = flight_record(campaign, args.realization)
+    print(format_record(record))
+    if out:
+        say(f"wrote {write_series(record, out)}: {len(record.series)} samples")
+    if kml:
+        say(f"wrote {write_kml(record, kml)}")
+    for path in plot_flight(record, args.plot_dir) if args.plot_dir else ():
+        say(f"wrote {path}")
+    return 0
+
+
 MAX_STATIC_S = 86_400.0
 """Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
 MAX_MACH = 10.0
@@ -557,6 +587,15 @@ def build_parser() -> argparse.ArgumentParser:
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
     navigate.add_argument("--force", action="store_true", help="replace an existing --out file")
     navigate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
+    fly = commands.add_parser("fly", help="one flight's full time series, summary, figures and KML path")
+    fly.add_argument("campaign", help="campaign file (TOML)")
+    fly.add_argument("--realization", type=int, metavar="I",
+                     help="fly realization I, bit for bit as in a campaign run (default: the nominal flight)")  # fmt: skip
+    fly.add_argument("--out", metavar="FLIGHT.csv|.h5", help="write the time series (CSV or HDF5, with units)")
+    fly.add_argument("--plot-dir", metavar="DIR", help="folder for the figures (path, altitude and speed, angles, margin)")
+    fly.add_argument("--kml", metavar="PATH", help="write the flight path as KML (Google Earth)")
+    fly.add_argument("--force", action="store_true", help="replace existing --out and --kml files")
+    fly.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")
     validate.add_argument("--campaign", help="another campaign file to fly instead of the built-in one")
@@ -611,7 +650,7 @@ def main(argv: list[str] | None = None) -> int:
         if not all(0 < v < float("inf") for v in spreads) or not 0 <= (args.gnss_after or 0.0) < float("inf"):
             parser.error("--gnss-std and --field-direction-std must be positive, --gnss-after at least 0")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
-               "sensors": _sensors_simulate, "navigate": _navigate, "validate": _validate, "bench": _bench}  # fmt: skip
+               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

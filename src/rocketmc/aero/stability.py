@@ -11,7 +11,7 @@ import jax.numpy as jnp
 
 from ..math import Vec3
 from .airdata import AirData
-from .model import LinearAero, TableAero, linear_derivatives, table_coefficients
+from .model import LinearAero, TableAero, aero_coefficients, linear_derivatives
 
 ALPHA_STEP_RAD = 1e-4
 """Half-step of the central difference in α on interpolated tables [rad]: inside the cells around zero, as
@@ -32,14 +32,29 @@ def normal_force_slopes(aero: TableAero | LinearAero, mach: float, altitude_m: f
 @jax.jit
 def _table_slopes(aero: TableAero, mach, altitude_m):
     """(CNα, Cmα) of ``normal_force_slopes`` for interpolated tables, compiled (op by op it takes seconds)."""
-    neutral, still = jnp.zeros(aero.canard_roll_rad.shape), Vec3(0.0, 0.0, 0.0)
+    return slopes_at(aero, AirData(1.0, 0.0, 0.0, mach, 0.5, 1.0, altitude_m), aero.moment_ref_x_m)
+
+
+def slopes_at(aero: TableAero | LinearAero, air: AirData, cg_x_m):
+    """(CNα, Cmα) [per rad], traceable: the central difference of the model's own CN and Cm (about its moment
+    reference) at α = ±``ALPHA_STEP_RAD``, β = 0, no rates, canards neutral, at the Mach number and altitude of
+    ``air``; ``cg_x_m``: the CG's body x [m] (the canard tables' incidences)."""
 
     def at(alpha):
-        c = table_coefficients(aero, AirData(1.0, alpha, 0.0, mach, 0.5, 1.0, altitude_m), still,
-                               aero.moment_ref_x_m, neutral)[0]  # fmt: skip
+        c, _ = aero_coefficients(aero, air._replace(alpha=alpha, beta=0.0 * alpha), Vec3.zeros(alpha), cg_x_m,
+                                 jnp.zeros(aero.n_canards))  # fmt: skip
         return jnp.stack([c.cn, c.cm])
 
-    return (at(ALPHA_STEP_RAD) - at(-ALPHA_STEP_RAD)) / (2 * ALPHA_STEP_RAD)
+    step = jnp.asarray(ALPHA_STEP_RAD)
+    cn_alpha, cm_alpha = (at(step) - at(-step)) / (2 * ALPHA_STEP_RAD)
+    return cn_alpha, cm_alpha
+
+
+def centre_of_pressure_at(aero: TableAero | LinearAero, air: AirData, cg_x_m):
+    """Body-frame x of the centre of pressure [m, from the reference point, positive toward the nose],
+    traceable: x_mref + d·Cmα/CNα from ``slopes_at`` (for a flight's time series)."""
+    cn_alpha, cm_alpha = slopes_at(aero, air, cg_x_m)
+    return aero.moment_ref_x_m + aero.reference_length_m * cm_alpha / cn_alpha
 
 
 def centre_of_pressure_x_m(aero: TableAero | LinearAero, mach: float, altitude_m: float = 0.0) -> float:

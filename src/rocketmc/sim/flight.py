@@ -15,7 +15,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ..aero import aero_coefficients, aero_wrench, air_data
+from ..aero import AirData, aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis, normalize_attitude
@@ -139,9 +139,26 @@ def mass_properties(p: FlightParams, t) -> MassProperties:
     )
 
 
-def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events):
-    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad] and a
-    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind."""
+class Loads(NamedTuple):
+    """What acts on the rocket at one instant (``loads``): its mass properties, the air data, the thrust
+    along body x [N], the aerodynamic force at the moment reference [N, FRD], the parachutes' force [N, NED],
+    the moment of everything about the CG [N·m, FRD], whether a canopy is open (bool), the canopy ω²
+    [1/s²] and whether the aerodynamic tables were left (bool)."""
+
+    mass: MassProperties
+    air: AirData
+    thrust: jnp.ndarray
+    aero_force_b: Vec3
+    chute_force_n: Vec3
+    moment_b: Vec3
+    under_canopy: jnp.ndarray
+    canopy_stiffness: jnp.ndarray
+    outside_tables: jnp.ndarray
+
+
+def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events) -> Loads:
+    """The ``Loads`` at ``t`` [s] on ``body`` with canard deflections δ1..δn [rad] and a turbulent gust
+    ``gust_n`` [m/s, NED] on top of the mean wind (``derivatives``' forces, also read by ``analysis``)."""
     rocket, env = p.rocket, p.environment
     mass = mass_properties(p, t)
     altitude = -body.r_n.z
@@ -174,8 +191,15 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
-    force_b = aero_force_b + Vec3(thrust_n, 0.0, 0.0)
-    free = rigid_body_derivatives(body, mass, force_b, force_n, moment_b, G0)
+    return Loads(mass, air, thrust_n, aero_force_b, force_n, moment_b, under_canopy, stiffness, outside_tables)
+
+
+def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events):
+    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad] and a
+    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind."""
+    f = loads(t, body, p, deflections, gust_n, events)
+    force_b = f.aero_force_b + Vec3(f.thrust, 0.0, 0.0)
+    free = rigid_body_derivatives(body, f.mass, force_b, f.chute_force_n, f.moment_b, G0)
 
     # On the rail: motion along it only, no rotation, no sliding back down before liftoff.
     rail = p.launch.rail_direction_n
@@ -184,8 +208,8 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     zero = jnp.zeros_like(accel_along)
     on_rail = RigidBodyState(body.v_n, rail * accel_along, Quat(zero, zero, zero, zero), Vec3(zero, zero, zero))
     d_body = tree_where(jnp.isinf(events.rail_exit_time), on_rail, free)
-    qbar_outside = jnp.where(outside_tables & ~under_canopy, air.qbar, 0.0)
-    return d_body, Diagnostics(air.mach, air.qbar, stiffness, qbar_outside)
+    qbar_outside = jnp.where(f.outside_tables & ~f.under_canopy, f.air.qbar, 0.0)
+    return d_body, Diagnostics(f.air.mach, f.air.qbar, f.canopy_stiffness, qbar_outside)
 
 
 def _crossing_fraction(g0, g1):
@@ -325,6 +349,17 @@ def control_period(p: FlightParams, settings: SimSettings, state: FlightState):
     return jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
 
 
+def period_gust(p: FlightParams, state: FlightState):
+    """The mean wind at the period start's height [m/s, NED], the turbulence's ``turbulence_scales`` there (None
+    without turbulence) and the gust held over the period starting at ``state`` [m/s, NED]."""
+    altitude = -state.body.r_n.z
+    mean_wind_n = p.environment.wind.velocity_n(altitude)
+    if p.environment.turbulence is None:
+        return mean_wind_n, None, Vec3.zeros(state.t)
+    scales = turbulence_scales(p.environment.turbulence, altitude)
+    return mean_wind_n, scales, gust_n(state.turbulence, scales, mean_wind_n, state.body.q_nb)
+
+
 def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None,
     first_stage: bool = False,
@@ -340,12 +375,7 @@ def control_step(
     """
     h = period / settings.substeps
     turbulence = p.environment.turbulence
-    altitude = -state.body.r_n.z
-    mean_wind_n = p.environment.wind.velocity_n(altitude)
-    gust = Vec3.zeros(state.t)
-    if turbulence is not None:
-        scales = turbulence_scales(turbulence, altitude)
-        gust = gust_n(state.turbulence, scales, mean_wind_n, state.body.q_nb)
+    mean_wind_n, scales, gust = period_gust(p, state)
 
     def rhs(t, y, events):
         d_body, diag = derivatives(t, y, p, deflections(t), gust, events)

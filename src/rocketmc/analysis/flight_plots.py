@@ -1,0 +1,123 @@
+"""Figures of one flight's time series (``rocketmc fly --plot DIR``): the 3-D path, altitude and speed, the angles
+of attack and the static margin against time, each sample a period start of the flight's own periods."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..files import replacing
+from .flight_record import FlightRecord, ascent, events
+
+FIGURES = ("path_3d.png", "altitude_speed.png", "angles_of_attack.png", "stability_margin.png")
+_EVENT_COLORS = {"rail exit": "tab:gray", "burnout": "tab:red", "apogee": "tab:green", "impact": "black"}
+_CHUTE_COLORS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive")
+
+
+def _save(fig: Figure, path: Path) -> None:
+    fig.tight_layout()
+    with replacing(path) as partial:
+        fig.savefig(partial, format="png", dpi=150)
+
+
+def _events(axes, record: FlightRecord, until: float | None = None) -> None:
+    """Dashed vertical lines at the events (up to ``until`` [s]), labelled in the first axes' legend."""
+    chute_colors = iter(_CHUTE_COLORS * len(record.campaign.config.rocket.parachutes))
+    for name, t in events(record):
+        color = _EVENT_COLORS.get(name) or next(chute_colors)  # the parachutes' in the order they deploy
+        if until is not None and t > until:
+            continue
+        for k, ax in enumerate(axes):
+            ax.axvline(t, color=color, linestyle="--", linewidth=0.8, label=f"{name} ({t:.2f} s)" if k == 0 else None)
+
+
+def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
+    """Write the ``FIGURES`` of ``record`` in ``directory`` (created if need be); returns their paths."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = [directory / name for name in FIGURES]
+    s, m = record.series, record.summary
+    t = s["time"].to_numpy()
+
+    fig = Figure(figsize=(8.0, 7.0))
+    ax = fig.add_subplot(projection="3d")
+    phases = list(dict.fromkeys(s["phase"]))
+    for phase in phases:  # each phase its colour, joined to the next one's first sample
+        idx = np.nonzero(s["phase"].to_numpy() == phase)[0]
+        idx = np.r_[idx, idx[-1] + 1] if idx[-1] + 1 < len(s) else idx
+        ax.plot(s["east"].to_numpy()[idx], s["north"].to_numpy()[idx], s["altitude"].to_numpy()[idx], linewidth=1.5,
+                label=phase)  # fmt: skip
+    ax.plot(s["east"], s["north"], 0.0 * t, color="0.7", linewidth=0.8, label="ground track")
+    ax.scatter([0.0], [0.0], [0.0], color="black", marker="^", s=50, label="pad")
+    if not np.isnan(m["apogee_time_s"]):
+        ax.scatter([m["apogee_east_m"]], [m["apogee_north_m"]], [m["apogee_agl_m"]], color="tab:green", s=30,
+                   label=f"apogee {m['apogee_agl_m']:.0f} m")  # fmt: skip
+    if not np.isnan(m["impact_time_s"]):
+        ax.scatter([m["impact_east_m"]], [m["impact_north_m"]], [0.0], color="black", marker="x", s=50, label="impact")
+    ax.set_xlabel("east of the pad [m]")
+    ax.set_ylabel("north of the pad [m]")
+    ax.set_zlabel("altitude above the pad [m]")
+    ax.set_title(f"{record.label}: flight path")
+    ax.legend(fontsize="small", loc="upper left")
+    _save(fig, paths[0])
+
+    fig = Figure(figsize=(9.0, 7.5))
+    ax_alt, ax_speed = fig.subplots(2, 1, sharex=True)
+    ax_alt.plot(t, s["altitude"], color="tab:blue", label="altitude above the pad")
+    ax_alt.set_ylabel("altitude above the pad [m]")
+    ax_speed.plot(t, s["speed"], color="tab:blue", label="speed over ground")
+    ax_speed.plot(t, s["airspeed"], color="tab:orange", linewidth=0.8, label="airspeed")
+    ax_speed.plot(t, -s["v_down"], color="tab:green", linewidth=0.8, label="vertical speed (up)")
+    ax_speed.set_ylabel("speed [m/s]")
+    ax_speed.set_xlabel("time since the start on the rail [s]")
+    _events((ax_alt, ax_speed), record)
+    ax_alt.legend(fontsize="small", loc="upper right")
+    ax_speed.legend(fontsize="small", loc="upper right")
+    for a in (ax_alt, ax_speed):
+        a.grid(alpha=0.3)
+    ax_alt.set_title(f"{record.label}: altitude and speed")
+    _save(fig, paths[1])
+
+    up = shown = ascent(record)  # off the rail (slow, so large angles in a wind) and before the canopies
+    end = m["apogee_time_s"]
+    fig = Figure(figsize=(9.0, 7.5))
+    ax_angles, ax_mach = fig.subplots(2, 1, sharex=True)
+    ax_angles.plot(shown["time"], shown["alpha"], label="angle of attack α")
+    ax_angles.plot(shown["time"], shown["beta"], label="sideslip β")
+    ax_angles.plot(shown["time"], shown["total_alpha"], color="black", linewidth=0.8, label="total angle of attack")
+    ax_angles.set_ylabel("angle [deg]")
+    ax_mach.plot(shown["time"], shown["mach"], color="tab:blue", label="Mach number")
+    ax_mach.set_ylabel("Mach number [-]")
+    ax_q = ax_mach.twinx()
+    ax_q.plot(shown["time"], shown["dynamic_pressure"] / 1000.0, color="tab:red", linewidth=0.8, label="dynamic pressure")
+    ax_q.set_ylabel("dynamic pressure [kPa]", color="tab:red")
+    ax_mach.set_xlabel("time since the start on the rail [s]")
+    _events((ax_angles, ax_mach), record, end)
+    ax_angles.legend(fontsize="small", loc="upper right")
+    lines = ax_mach.get_legend_handles_labels()[0] + ax_q.get_legend_handles_labels()[0]
+    ax_mach.legend(lines, [h.get_label() for h in lines], fontsize="small", loc="upper right")
+    for a in (ax_angles, ax_mach):
+        a.grid(alpha=0.3)
+    ax_angles.set_title(f"{record.label}: angles of attack, rail exit to apogee\n"
+                        "(air-relative velocity: mean wind and gust)")  # fmt: skip
+    _save(fig, paths[2])
+
+    fig = Figure(figsize=(9.0, 7.5))
+    ax_margin, ax_position = fig.subplots(2, 1, sharex=True)
+    ax_margin.plot(up["time"], up["static_margin"], color="tab:blue", label="static margin (CP − CG)/d")
+    ax_margin.set_ylabel("static margin [calibers]")
+    ax_position.plot(up["time"], up["cp"], color="tab:red", label="centre of pressure (Mach, small α)")
+    ax_position.plot(up["time"], up["cg"], color="tab:blue", label="centre of mass")
+    ax_position.set_ylabel("distance from the nose tip [m]")
+    ax_position.invert_yaxis()  # the nose on top, the tail below
+    ax_position.set_xlabel("time since the start on the rail [s]")
+    _events((ax_margin, ax_position), record, m["apogee_time_s"])
+    ax_margin.legend(fontsize="small", loc="lower right")
+    ax_position.legend(fontsize="small", loc="lower right")
+    for a in (ax_margin, ax_position):
+        a.grid(alpha=0.3)
+    ax_margin.set_title(f"{record.label}: static stability, rail exit to apogee")
+    _save(fig, paths[3])
+    return paths
