@@ -322,7 +322,8 @@ def _navigate(args) -> int:
     if args.plot:  # before the replay: a folder that cannot be made is said at once
         Path(args.plot).mkdir(parents=True, exist_ok=True)
     params = nav_replay.retuned(filter_params(campaign), None if args.barometer is None else args.barometer == "on",
-                                args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std)  # fmt: skip
+                                args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std,
+                                None if args.gates is None else args.gates == "on")  # fmt: skip
     launch, site = config.launch, config.site
     say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     say(f"{args.log_dir}: {len(log['imu'])} IMU ticks, {len(log['baro'])} barometer and {len(log['gnss'])} GNSS "
@@ -339,9 +340,12 @@ def _navigate(args) -> int:
     gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
     print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
           f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'}, field direction σ "
-          f"{float(params.attitude.field_direction_std):g}")  # fmt: skip
+          f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²) magnetometer {params.field_gate}, "
+          f"GNSS {params.gnss_gate}, barometer {params.altitude_gate}")  # fmt: skip
     print(f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
           f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {nav_replay.pad_pressure(nav):.1f} Pa")  # fmt: skip
+    print(f"  rejected by the gates: {nav['rejected_field'].iloc[-1]} magnetometer, {nav['rejected_gnss'].iloc[-1]} "
+          f"GNSS and {nav['rejected_baro'].iloc[-1]} barometer samples")
     print(f"  estimated apogee {nav['height_m'][top]:.1f} m at {nav['t_s'][top]:.2f} s"
           + ("; the covariance failed, estimates held from then" if nav["failed"].any() else ""))  # fmt: skip
     print(f"  {'against the log':<46}{'RMS':>8}{'max':>8}")
@@ -505,6 +509,8 @@ def main(argv: list[str] | None = None) -> int:
                                "(default: the campaign's)")  # fmt: skip
     navigate.add_argument("--field-direction-std", type=float, metavar="S",
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--gates", choices=("on", "off"),
+                          help="off: no innovation gate on any update (default: the campaign's gates)")  # fmt: skip
     navigate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
     validate.add_argument("flight", choices=sorted(FLIGHTS), help="the flight")

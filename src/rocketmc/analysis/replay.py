@@ -144,7 +144,9 @@ def replay(log: Mapping[str, pd.DataFrame], params: FilterParams, q_nb0: Quat, s
     v_north_mps, v_east_mps, v_down_mps; bias_{x,y,z}_deg_s, the gyro bias [deg/s, body]; the standard deviations
     attitude_std_{x,y,z}_deg (body axes), bias_std_{x,y,z}_deg_s, {north,east,down}_std_m,
     v_{north,east,down}_std_mps (square roots of the covariances' diagonals); pad_pressure_pa (the mean of the
-    barometer's samples before liftoff was sensed; NaN before any); failed (a covariance went bad: estimates held).
+    barometer's samples before liftoff was sensed; NaN before any); failed (a covariance went bad: estimates held);
+    rejected_field, rejected_gnss, rejected_baro: the fresh samples the updates' innovation gates rejected so far
+    (``FilterParams.field_gate`` etc.; 0 without a gate).
     """
     if params.pad_samples:
         raise ValueError('gnc.filters.initialisation = "pad" needs samples on the pad, and a log starts at liftoff '
@@ -180,6 +182,8 @@ def replay(log: Mapping[str, pd.DataFrame], params: FilterParams, q_nb0: Quat, s
     count = states.pad_pressure_count
     columns["pad_pressure_pa"] = np.where(count > 0, states.pad_pressure_sum / np.maximum(count, 1), np.nan)
     columns["failed"] = states.failed
+    for i, sensor in enumerate(("field", "gnss", "baro")):
+        columns[f"rejected_{sensor}"] = states.rejected[:, i]
     return pd.DataFrame(columns)
 
 
@@ -403,17 +407,20 @@ def rail_attitude(elevation_deg: float, azimuth_deg: float) -> Quat:
 
 def retuned(params: FilterParams, barometer: bool | None = None, gnss: str | None = None,
             gnss_after_s: float | None = None, gnss_std: tuple[float, float] | None = None,
-            field_direction_std: float | None = None) -> FilterParams:  # fmt: skip
+            field_direction_std: float | None = None, gates: bool | None = None) -> FilterParams:  # fmt: skip
     """``params`` with the knobs of ``rocketmc navigate`` replaced where given (the fields of ``[gnc.filters]``):
     the barometric height update; the GNSS's axes ("all" or "horizontal"), the time from which its fixes are used
     [s since liftoff] and its standard deviations (position [m], velocity [m/s], the same on every axis); the
-    magnetometer's field direction standard deviation [-]."""
+    magnetometer's field direction standard deviation [-]; gates False: every innovation gate off (True: the
+    campaign's)."""
     position, attitude = params.position, params.attitude
     if gnss_std is not None:
         position = dataclasses.replace(position, gnss_position_std=Vec3(*(jnp.asarray(float(gnss_std[0])),) * 3),
                                        gnss_velocity_std=Vec3(*(jnp.asarray(float(gnss_std[1])),) * 3))  # fmt: skip
     if field_direction_std is not None:
         attitude = dataclasses.replace(attitude, field_direction_std=jnp.asarray(float(field_direction_std)))
+    if gates is False:
+        params = dataclasses.replace(params, field_gate=None, gnss_gate=None, altitude_gate=None)
     return dataclasses.replace(
         params, attitude=attitude, position=position,
         barometer=params.barometer if barometer is None else barometer,
