@@ -329,7 +329,9 @@ def _navigate(args) -> int:
     say(f"{args.log_dir}: {len(log['imu'])} IMU ticks, {len(log['baro'])} barometer and {len(log['gnss'])} GNSS "
         f"samples; {config.name}'s site and rail ({launch.elevation_deg:g}° toward {launch.azimuth_deg:g}°) "
         "(compiling, then replaying)")  # fmt: skip
-    nav = nav_replay.replay(log, params, nav_replay.rail_attitude(launch.elevation_deg, launch.azimuth_deg), site)
+    q_nb0 = (nav_replay.accelerometer_attitude(log, launch.azimuth_deg) if args.initial_attitude == "accelerometer"
+             else nav_replay.rail_attitude(launch.elevation_deg, launch.azimuth_deg))  # fmt: skip
+    nav = nav_replay.replay(log, params, q_nb0, site)
     try:
         windows = nav_replay.flight_windows(nav, log)
     except ValueError as e:
@@ -509,6 +511,9 @@ def main(argv: list[str] | None = None) -> int:
                                "(default: the campaign's)")  # fmt: skip
     navigate.add_argument("--field-direction-std", type=float, metavar="S",
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--initial-attitude", choices=("rail", "accelerometer"), default="rail",
+                          help="the attitude at liftoff: the campaign's rail elevation and azimuth, or the pitch and "
+                               "roll of the log's first accelerometer sample with the rail's azimuth (default: rail)")  # fmt: skip
     navigate.add_argument("--gates", choices=("on", "off"),
                           help="off: no innovation gate on any update (default: the campaign's gates)")  # fmt: skip
     navigate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")

@@ -405,6 +405,16 @@ def rail_attitude(elevation_deg: float, azimuth_deg: float) -> Quat:
     return Launch.from_angles(1.0, math.radians(elevation_deg), math.radians(azimuth_deg)).q_nb0
 
 
+def accelerometer_attitude(log: Mapping[str, pd.DataFrame], azimuth_deg: float) -> Quat:
+    """q_nb at liftoff with the pitch and roll of the log's first accelerometer sample (at rest on the rail, it reads
+    "up", g (sin θ, −cos θ sin φ, −cos θ cos φ) in FRD: θ = atan2(f_x, √(f_y² + f_z²)), φ = atan2(−f_y, −f_z)) and
+    the yaw ``azimuth_deg`` (the accelerometer cannot see it). The real log's sample 0 reads 83.2° (the thesis's
+    rail: 84°), where the campaign's trajectory fit has 79°."""
+    f = log["imu"][[f"acc_{a}_mps2" for a in "xyz"]].to_numpy(dtype=float)[0]
+    return Quat.from_euler(jnp.asarray(math.radians(azimuth_deg)), jnp.arctan2(f[0], math.hypot(f[1], f[2])),
+                           jnp.arctan2(-f[1], -f[2]))  # fmt: skip
+
+
 def retuned(params: FilterParams, barometer: bool | None = None, gnss: str | None = None,
             gnss_after_s: float | None = None, gnss_std: tuple[float, float] | None = None,
             field_direction_std: float | None = None, gates: bool | None = None) -> FilterParams:  # fmt: skip
