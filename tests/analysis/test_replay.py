@@ -246,3 +246,15 @@ def test_real_log_descent_height_with_the_barometer():
     assert windows["coast"][0] == pytest.approx(3.2, abs=0.1) and windows["coast"][1] == pytest.approx(17.76, abs=0.1)
     assert windows["descent"][1] == pytest.approx(104.8, abs=0.5)  # the landing shock (flight_log.reduce_flight)
     assert replay.navigation_metrics(nav, log, windows)["height_rms_descent_m"] <= 10.0
+
+
+def test_the_attitude_at_liftoff_from_the_first_accelerometer_sample():
+    """``accelerometer_attitude`` on the real log: "up" (NED (0, 0, −1)) in its body axes is the direction of sample
+    0's specific force (1e-12: rounding), its yaw the azimuth given, its pitch 83.2° (SOURCE.md's rail: 84°)."""
+    log = read_sensor_log(ROCCARASO_2021)
+    q = replay.accelerometer_attitude(log, 140.0)
+    f = log["imu"][[f"acc_{a}_mps2" for a in "xyz"]].to_numpy()[0]
+    up = np.asarray(q.rotate_inverse(Vec3(0.0, 0.0, -1.0)).to_array())
+    np.testing.assert_allclose(up, f / np.linalg.norm(f), rtol=0, atol=1e-12)
+    yaw, pitch, _ = (math.degrees(float(a)) for a in q.to_euler())
+    assert yaw == pytest.approx(140.0, abs=1e-9) and pitch == pytest.approx(83.15, abs=0.01)
