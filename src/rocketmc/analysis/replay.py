@@ -19,7 +19,8 @@ Differences from the flight, each forced by the log: the log has no GNSS altitud
 never measured (``NO_GNSS_ALTITUDE_STD_M``; its down velocity is, with ``gnss = "all"``); the filters are never idle
 (in flight they freeze once a parachute is triggered: here the descent is navigated too); a log starts at liftoff,
 so the pad pressure of the barometric height is the mean of the barometer's samples before liftoff is sensed (the
-first one or two) and a TRIAD initialisation from pad samples is impossible (ValueError).
+first one or two) and a TRIAD initialisation from pad samples is impossible (ValueError): the attitude at liftoff is
+the rail's (``rail_attitude``) or the tilt of the log's first accelerometer sample (``accelerometer_attitude``).
 """
 
 from __future__ import annotations
