@@ -342,8 +342,9 @@ def _navigate(args) -> int:
     gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
     print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
           f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'}, field direction σ "
-          f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²) magnetometer {params.field_gate}, "
-          f"GNSS {params.gnss_gate}, barometer {params.altitude_gate}")  # fmt: skip
+          f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): " + ", ".join(
+              f"{name} {'off' if gate is None else f'{gate:g}'}" for name, gate in
+              (("magnetometer", params.field_gate), ("GNSS", params.gnss_gate), ("barometer", params.altitude_gate))))  # fmt: skip
     print(f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
           f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {nav_replay.pad_pressure(nav):.1f} Pa")  # fmt: skip
     print(f"  rejected by the gates: {nav['rejected_field'].iloc[-1]} magnetometer, {nav['rejected_gnss'].iloc[-1]} "
