@@ -220,8 +220,9 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     """The filters' solution at time t [s] from the measurements ``m``. Position and velocity are propagated from the
     last solution with the accelerometer's sample then (rotated into NED by the attitude then, plus gravity), the
     attitude with the gyroscope's rates then; the magnetometer updates the attitude, the GNSS (after
-    ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh. On the pad (``moving``
-    False: liftoff not yet sensed) the pad sums grow; after ``pad_samples`` ticks there TRIAD sets the attitude.
+    ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh (and accepted by its gate,
+    ``innovation_gate``; the rejections counted). On the pad (``moving`` False: liftoff not yet sensed) the pad sums
+    grow; after ``pad_samples`` ticks there TRIAD sets the attitude.
     ``idle`` (a parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
     solution (body rates: the gyroscope's less the estimated bias) and the new state (its ``errors`` untouched:
     ``track_errors``)."""
