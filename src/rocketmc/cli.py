@@ -359,13 +359,16 @@ def _navigate(args) -> int:
     if args.plot_dir:  # before the replay: a folder that cannot be made is said at once
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     params = nav_replay.retuned(filter_params(campaign), None if args.barometer is None else args.barometer == "on",
-                                args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std)  # fmt: skip
+                                args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std,
+                                None if args.gates is None else args.gates == "on")  # fmt: skip
     launch, site = config.launch, config.site
     say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     say(f"{args.log_dir}: {len(log['imu'])} IMU ticks, {len(log['baro'])} barometer and {len(log['gnss'])} GNSS "
         f"samples; {config.name}'s site and rail ({launch.elevation_deg:g}° toward {launch.azimuth_deg:g}°) "
         "(compiling, then replaying)")  # fmt: skip
-    nav = nav_replay.replay(log, params, nav_replay.rail_attitude(launch.elevation_deg, launch.azimuth_deg), site)
+    q_nb0 = (nav_replay.accelerometer_attitude(log, launch.azimuth_deg) if args.initial_attitude == "accelerometer"
+             else nav_replay.rail_attitude(launch.elevation_deg, launch.azimuth_deg))  # fmt: skip
+    nav = nav_replay.replay(log, params, q_nb0, site)
     try:
         windows = nav_replay.flight_windows(nav, log)
     except ValueError as e:
@@ -376,9 +379,13 @@ def _navigate(args) -> int:
     gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
     print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
           f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'}, field direction σ "
-          f"{float(params.attitude.field_direction_std):g}")  # fmt: skip
+          f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): " + ", ".join(
+              f"{name} {'off' if gate is None else f'{gate:g}'}" for name, gate in
+              (("magnetometer", params.field_gate), ("GNSS", params.gnss_gate), ("barometer", params.altitude_gate))))  # fmt: skip
     print(f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
           f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {nav_replay.pad_pressure(nav):.1f} Pa")  # fmt: skip
+    print(f"  rejected by the gates: {nav['rejected_field'].iloc[-1]} magnetometer, {nav['rejected_gnss'].iloc[-1]} "
+          f"GNSS and {nav['rejected_baro'].iloc[-1]} barometer samples")
     print(f"  estimated apogee {nav['height_m'][top]:.1f} m at {nav['t_s'][top]:.2f} s"
           + ("; the covariance failed, estimates held from then" if nav["failed"].any() else ""))  # fmt: skip
     print(f"  {'against the log':<46}{'RMS':>8}{'max':>8}")
@@ -585,6 +592,11 @@ def build_parser() -> argparse.ArgumentParser:
                                "(default: the campaign's)")  # fmt: skip
     navigate.add_argument("--field-direction-std", type=float, metavar="S",
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
+    navigate.add_argument("--initial-attitude", choices=("rail", "accelerometer"), default="rail",
+                          help="the attitude at liftoff: the campaign's rail elevation and azimuth, or the pitch and "
+                               "roll of the log's first accelerometer sample with the rail's azimuth (default: rail)")  # fmt: skip
+    navigate.add_argument("--gates", choices=("on", "off"),
+                          help="off: no innovation gate on any update (default: the campaign's gates)")  # fmt: skip
     navigate.add_argument("--force", action="store_true", help="replace an existing --out file")
     navigate.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     fly = commands.add_parser("fly", help="one flight's full time series, summary, figures and KML path")

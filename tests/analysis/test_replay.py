@@ -142,6 +142,32 @@ def test_replayed_navigation_tracks_the_truth(flight):
     assert np.sqrt(np.mean(angle**2)) < 6.0
 
 
+def test_the_barometers_gate_rejects_a_glitch_and_accepts_the_rest(flight):
+    """A glitch of the simulated log's barometer (5 samples 3 kPa low, ~300 m high, at 6 s: the real log's transonic
+    drop is 250 m) is rejected by a gate of 100 (10σ; its normalised innovation squared is ~3000) and every other
+    sample accepted (the pad pressure's few metres and the barometer's 5 m noise: ~1-10); a gate that rejects
+    nothing leaves every estimate bit-identical to no gate."""
+    params = _tuned(flight, barometer=True, gnss="all", gnss_after_s=0.0, gnss_std=GNSS_STD)
+    q_nb0, _ = _start(flight)
+    site = flight["campaign"].config.site
+    log = dict(flight["log"])
+    baro = log["baro"].copy()
+    glitch = np.flatnonzero(baro["t_s"].to_numpy() >= 6.0)[:5]
+    baro.loc[glitch, "pressure_pa"] -= 3000.0
+    log["baro"] = baro
+    plain = replay.replay(log, params, q_nb0, site)
+    gated = replay.replay(log, dataclasses.replace(params, altitude_gate=100.0), q_nb0, site)
+    wide = replay.replay(log, dataclasses.replace(params, altitude_gate=1e4), q_nb0, site)
+    rejected = np.diff(gated["rejected_baro"].to_numpy(), prepend=0)
+    at = np.searchsorted(gated["t_s"].to_numpy(), baro["t_s"].to_numpy()[glitch] - replay.SAME_TIME_S)  # their ticks
+    assert rejected.sum() == len(glitch) and np.all(rejected[at] == 1), (rejected.sum(), at)
+    assert gated[["rejected_field", "rejected_gnss"]].to_numpy().max() == 0
+    after = gated["t_s"] > 7.0
+    # the glitch pulls the ungated height by metres (3 kPa over σ 5 m, gain ~0.1-0.3 a sample); the gated one not at all
+    assert (plain["height_m"] - gated["height_m"])[after].abs().max() > 1.0
+    assert wide.equals(plain)  # nothing rejected: the same estimates, bit for bit
+
+
 def test_navigate_reads_a_simulated_log(flight, tmp_path, capsys):
     """The simulated log written as ``rocketmc sensors simulate`` writes it (its GNSS's satellite count NaN: not
     modelled; a stream whose first sample after liftoff comes later than liftoff starts there) reads back as it was
@@ -220,3 +246,15 @@ def test_real_log_descent_height_with_the_barometer():
     assert windows["coast"][0] == pytest.approx(3.2, abs=0.1) and windows["coast"][1] == pytest.approx(17.76, abs=0.1)
     assert windows["descent"][1] == pytest.approx(104.8, abs=0.5)  # the landing shock (flight_log.reduce_flight)
     assert replay.navigation_metrics(nav, log, windows)["height_rms_descent_m"] <= 10.0
+
+
+def test_the_attitude_at_liftoff_from_the_first_accelerometer_sample():
+    """``accelerometer_attitude`` on the real log: "up" (NED (0, 0, −1)) in its body axes is the direction of sample
+    0's specific force (1e-12: rounding), its yaw the azimuth given, its pitch 83.2° (SOURCE.md's rail: 84°)."""
+    log = read_sensor_log(ROCCARASO_2021)
+    q = replay.accelerometer_attitude(log, 140.0)
+    f = log["imu"][[f"acc_{a}_mps2" for a in "xyz"]].to_numpy()[0]
+    up = np.asarray(q.rotate_inverse(Vec3(0.0, 0.0, -1.0)).to_array())
+    np.testing.assert_allclose(up, f / np.linalg.norm(f), rtol=0, atol=1e-12)
+    yaw, pitch, _ = (math.degrees(float(a)) for a in q.to_euler())
+    assert yaw == pytest.approx(140.0, abs=1e-9) and pitch == pytest.approx(83.15, abs=0.01)

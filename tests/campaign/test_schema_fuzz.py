@@ -472,6 +472,10 @@ def test_gnc_base_is_valid():
          "gnc.filters.position.initial_velocity_std_mps: Input should be greater than 0 (got 0.0)"),
         ("gnc.filters.position.gnss", "vertical", "gnc.filters.position.gnss: Input should be 'all' or 'horizontal'"),
         ("gnc.filters.pad_samples", 0, "gnc.filters.pad_samples: Input should be greater than or equal to 1"),
+        ("gnc.filters.position.altitude_gate", -9.0,
+         "gnc.filters.position.altitude_gate: Input should be greater than 0 (got -9.0)"),
+        ("gnc.filters.attitude.field_gate", 1e5, "gnc.filters.attitude.field_gate: Input should be less than or equal to"),
+        ("gnc.filters.position.gnss_gate", "tight", "gnc.filters.position.gnss_gate: Input should be a valid number"),
         ("gnc.filters.initialisation", "triad", "gnc.filters.initialisation: Input should be 'rail' or 'pad'"),
     ],
 )  # fmt: skip

@@ -26,6 +26,7 @@ from rocketmc.gnc.attitude_filter import (
     attitude_nees,
     error_transition,
     initial_attitude,
+    magnetometer_nis,
     magnetometer_update,
     propagate_attitude,
     rotation_step,
@@ -381,3 +382,22 @@ def test_vmap_matches_single_vehicle_calls():
         # the same arithmetic, fused differently by XLA in the batch: a few ulps
         for a, b in zip(jax.tree.leaves(one), jax.tree.leaves(jax.tree.map(lambda a: a[i], out))):
             np.testing.assert_allclose(a, b, rtol=1e-13, atol=1e-16)
+
+
+def test_magnetometer_innovation_square_equals_the_dense_one():
+    """``magnetometer_nis`` against eᵀ (H P Hᵀ + R)⁻¹ e with H = [[h×], 0] by numpy, on random correlated
+    covariances, attitudes and fields. 1e-11 relative: roundoff of the 3×3 adjugate inverse (S's condition number
+    is below ~1e3 here) against numpy's solve."""
+    rng = np.random.default_rng(18)
+    tuning = AttitudeTuning(field_direction_std=0.05)
+    for seed in range(5):
+        p = random_covariance(rng)
+        q = quat(Rotation.random(random_state=30 + seed))
+        field_b = rng.normal(size=3) * 30.0
+        r = np.array(FIELD_N) / np.linalg.norm(np.array(FIELD_N))
+        h = dcm(q).T @ r
+        hh = np.hstack([skew(h), np.zeros((3, 3))])
+        e = field_b / np.linalg.norm(field_b) - h
+        expected = e @ np.linalg.solve(hh @ p @ hh.T + tuning.field_direction_std**2 * np.eye(3), e)
+        nis = magnetometer_nis(estimate(q, np.zeros(3), p), vec(field_b), FIELD_N, tuning)
+        assert float(nis) == pytest.approx(expected, rel=1e-11)

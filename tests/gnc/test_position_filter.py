@@ -16,7 +16,9 @@ import scipy.stats
 from rocketmc.gnc.position_filter import (
     PositionEstimate,
     PositionTuning,
+    altitude_nis,
     altitude_update,
+    gnss_nis,
     gnss_update,
     initial_position,
     position_nees,
@@ -323,3 +325,27 @@ def test_vmap_equals_single_runs():
         for got, want in zip(jax.tree_util.tree_leaves(batched), jax.tree_util.tree_leaves(one)):
             # the same operations per lane; vectorized and scalar code may contract or order them differently
             assert float(got[i]) == pytest.approx(float(want), rel=1e-14, abs=1e-14)
+
+
+@pytest.mark.parametrize("horizontal_only", [False, True], ids=["all", "horizontal"])
+def test_innovation_squares_equal_the_6_state_filters(horizontal_only):
+    """``gnss_nis`` and ``altitude_nis`` against the dense 6-state filter's eᵀ (H P Hᵀ + R)⁻¹ e, on a random
+    propagated estimate (correlated r and v per axis) and random measurements. 1e-12 relative: roundoff of a
+    2×2 (or scalar) inverse against numpy's 6×6 solve."""
+    rng = np.random.default_rng(18)
+    est = initial_position(vec(rng.normal(size=3)), SHARP)
+    for _ in range(20):
+        est = propagate_position(est, vec(rng.normal(size=3)), T, SHARP)
+    x, p = to_dense(est)
+    z = x + rng.normal(size=6) * 4.0
+    h, r, rows = gnss_model(SHARP, horizontal_only)
+    e = z[rows] - x[rows]
+    expected = e @ np.linalg.solve(h @ p @ h.T + r, e)
+    nis = gnss_nis(est, vec(z[:3]), vec(z[3:]), SHARP, horizontal_only)
+    assert float(nis) == pytest.approx(expected, rel=1e-12)
+    height = -x[2] + 7.0
+    h_alt = np.zeros((1, 6))
+    h_alt[0, 2] = -1.0
+    e_alt = np.array([height - h_alt[0] @ x])
+    expected = e_alt @ np.linalg.solve(h_alt @ p @ h_alt.T + float(SHARP.altitude_std) ** 2, e_alt)
+    assert float(altitude_nis(est, jnp.asarray(height), SHARP)) == pytest.approx(float(expected), rel=1e-12)

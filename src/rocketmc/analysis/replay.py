@@ -19,7 +19,8 @@ Differences from the flight, each forced by the log: the log has no GNSS altitud
 never measured (``NO_GNSS_ALTITUDE_STD_M``; its down velocity is, with ``gnss = "all"``); the filters are never idle
 (in flight they freeze once a parachute is triggered: here the descent is navigated too); a log starts at liftoff,
 so the pad pressure of the barometric height is the mean of the barometer's samples before liftoff is sensed (the
-first one or two) and a TRIAD initialisation from pad samples is impossible (ValueError).
+first one or two) and a TRIAD initialisation from pad samples is impossible (ValueError): the attitude at liftoff is
+the rail's (``rail_attitude``) or the tilt of the log's first accelerometer sample (``accelerometer_attitude``).
 """
 
 from __future__ import annotations
@@ -144,7 +145,9 @@ def replay(log: Mapping[str, pd.DataFrame], params: FilterParams, q_nb0: Quat, s
     v_north_mps, v_east_mps, v_down_mps; bias_{x,y,z}_deg_s, the gyro bias [deg/s, body]; the standard deviations
     attitude_std_{x,y,z}_deg (body axes), bias_std_{x,y,z}_deg_s, {north,east,down}_std_m,
     v_{north,east,down}_std_mps (square roots of the covariances' diagonals); pad_pressure_pa (the mean of the
-    barometer's samples before liftoff was sensed; NaN before any); failed (a covariance went bad: estimates held).
+    barometer's samples before liftoff was sensed; NaN before any); failed (a covariance went bad: estimates held);
+    rejected_field, rejected_gnss, rejected_baro: the fresh samples the updates' innovation gates rejected so far
+    (``FilterParams.field_gate`` etc.; 0 without a gate).
     """
     if params.pad_samples:
         raise ValueError('gnc.filters.initialisation = "pad" needs samples on the pad, and a log starts at liftoff '
@@ -180,6 +183,8 @@ def replay(log: Mapping[str, pd.DataFrame], params: FilterParams, q_nb0: Quat, s
     count = states.pad_pressure_count
     columns["pad_pressure_pa"] = np.where(count > 0, states.pad_pressure_sum / np.maximum(count, 1), np.nan)
     columns["failed"] = states.failed
+    for i, sensor in enumerate(("field", "gnss", "baro")):
+        columns[f"rejected_{sensor}"] = states.rejected[:, i]
     return pd.DataFrame(columns)
 
 
@@ -401,19 +406,32 @@ def rail_attitude(elevation_deg: float, azimuth_deg: float) -> Quat:
     return Launch.from_angles(1.0, math.radians(elevation_deg), math.radians(azimuth_deg)).q_nb0
 
 
+def accelerometer_attitude(log: Mapping[str, pd.DataFrame], azimuth_deg: float) -> Quat:
+    """q_nb at liftoff with the pitch and roll of the log's first accelerometer sample (at rest on the rail, it reads
+    "up", g (sin θ, −cos θ sin φ, −cos θ cos φ) in FRD: θ = atan2(f_x, √(f_y² + f_z²)), φ = atan2(−f_y, −f_z)) and
+    the yaw ``azimuth_deg`` (the accelerometer cannot see it). The real log's sample 0 reads 83.2° (the thesis's
+    rail: 84°), where the campaign's trajectory fit has 79°."""
+    f = log["imu"][[f"acc_{a}_mps2" for a in "xyz"]].to_numpy(dtype=float)[0]
+    return Quat.from_euler(jnp.asarray(math.radians(azimuth_deg)), jnp.arctan2(f[0], math.hypot(f[1], f[2])),
+                           jnp.arctan2(-f[1], -f[2]))  # fmt: skip
+
+
 def retuned(params: FilterParams, barometer: bool | None = None, gnss: str | None = None,
             gnss_after_s: float | None = None, gnss_std: tuple[float, float] | None = None,
-            field_direction_std: float | None = None) -> FilterParams:  # fmt: skip
+            field_direction_std: float | None = None, gates: bool | None = None) -> FilterParams:  # fmt: skip
     """``params`` with the knobs of ``rocketmc navigate`` replaced where given (the fields of ``[gnc.filters]``):
     the barometric height update; the GNSS's axes ("all" or "horizontal"), the time from which its fixes are used
     [s since liftoff] and its standard deviations (position [m], velocity [m/s], the same on every axis); the
-    magnetometer's field direction standard deviation [-]."""
+    magnetometer's field direction standard deviation [-]; gates False: every innovation gate off (True: the
+    campaign's)."""
     position, attitude = params.position, params.attitude
     if gnss_std is not None:
         position = dataclasses.replace(position, gnss_position_std=Vec3(*(jnp.asarray(float(gnss_std[0])),) * 3),
                                        gnss_velocity_std=Vec3(*(jnp.asarray(float(gnss_std[1])),) * 3))  # fmt: skip
     if field_direction_std is not None:
         attitude = dataclasses.replace(attitude, field_direction_std=jnp.asarray(float(field_direction_std)))
+    if gates is False:
+        params = dataclasses.replace(params, field_gate=None, gnss_gate=None, altitude_gate=None)
     return dataclasses.replace(
         params, attitude=attitude, position=position,
         barometer=params.barometer if barometer is None else barometer,

@@ -613,6 +613,11 @@ class ControlConfig(_Strict):
 ONE_RAD_DEG = math.degrees(1.0)
 """The thesis's initial covariances are identities: 1 rad and 1 rad/s, in the campaign's degrees."""
 StdDeviation = Annotated[float, Field(gt=0, le=MAX_SENSOR_VALUE)]
+MAX_GATE = 1e4  # a χ² gate of 1e4 on the normalised innovation squared is a 100σ gate: none at all
+Gate = Annotated[float | None, Field(gt=0, le=MAX_GATE)]
+"""An update's χ² innovation gate [-]: fresh samples whose normalised innovation squared eᵀ S⁻¹ e exceeds it are
+rejected (``gnc.navigation.innovation_gate``); None (the default): no gate. E.g. the 99.7 % (3σ) quantiles: 8.8
+for 1 degree of freedom, 11.8 for 2, 16.3 for 4, 20.1 for 6."""
 
 
 class AttitudeFilterConfig(_Strict):
@@ -620,13 +625,15 @@ class AttitudeFilterConfig(_Strict):
     noise σ_v [deg/s/√s] and its bias's random walk σ_u [deg/s²/√s] (knobs about 10³ above the thesis gyro's own:
     the filter follows the magnetometer within ~0.3 s), the measured field direction's standard deviation [-] (a
     unit vector; the thesis's R = 4 I), the initial standard deviations of the attitude [deg] and gyro bias
-    [deg/s] per axis (the thesis's P0 = I)."""
+    [deg/s] per axis (the thesis's P0 = I); the magnetometer update's innovation gate (``Gate``, ~2 degrees of
+    freedom; the thesis has none)."""
 
     gyro_noise_deg_s: StdDeviation = 60.0
     bias_walk_deg_s2: StdDeviation = 10.0
     field_direction_std: StdDeviation = 2.0
     initial_attitude_std_deg: StdDeviation = ONE_RAD_DEG
     initial_bias_std_deg_s: StdDeviation = ONE_RAD_DEG
+    field_gate: Gate = None
 
 
 class PositionFilterConfig(_Strict):
@@ -634,7 +641,9 @@ class PositionFilterConfig(_Strict):
     defaults: process noise on position [m/√s] and velocity [m/s/√s]; the GNSS fixes used from ``gnss_after_s``
     (simulation time [s]), on every axis ("all") or north and east only ("horizontal", Skyward's avionics),
     with their standard deviations N, E, D (the thesis's, de-weighted ~100×); the barometric height update (off in
-    the thesis) and its standard deviation [m]; the initial standard deviations (the thesis's P0 = I)."""
+    the thesis) and its standard deviation [m]; the initial standard deviations (the thesis's P0 = I); the GNSS's
+    and the barometer's innovation gates (``Gate``; 2 degrees of freedom per GNSS axis, 1 for the barometer; the
+    thesis has none)."""
 
     position_noise_m: StdDeviation = 2.0
     velocity_noise_mps: StdDeviation = 1.0
@@ -647,6 +656,8 @@ class PositionFilterConfig(_Strict):
     # Lynx's 1.4 km pads (the thesis has no barometer update)
     initial_position_std_m: StdDeviation = 1.0
     initial_velocity_std_mps: StdDeviation = 1.0
+    gnss_gate: Gate = None
+    altitude_gate: Gate = None
 
 
 class FiltersConfig(_Strict):

@@ -272,6 +272,20 @@ def magnetometer_update(
     return AttitudeEstimate(q_nb, est.bias_b + dbeta, _covariance(new11, new12, new22))
 
 
+def magnetometer_nis(
+    est: AttitudeEstimate, field_measured_b: Vec3, reference_n: Vec3, tuning: AttitudeTuning
+) -> jnp.ndarray:
+    """``magnetometer_update``'s normalised innovation squared eᵀ S⁻¹ e [-], e = b − h, S = [h×] P11 [h×]ᵀ + σ_b² I
+    (b, h unit vectors: e is tangential to first order, so ~χ² with 2 degrees of freedom)."""
+    b, r = _unit(field_measured_b), _unit(reference_n)
+    h = est.q_nb.rotate_inverse(r)
+    hx = _cross_matrix(h)
+    p11 = _blocks(est.cov)[0]
+    innovation = b - h
+    s = _add(_scale(_mm(_mm(hx, p11), hx), -1.0), _eye(tuning.field_direction_std**2))  # [h×]ᵀ = −[h×]
+    return innovation.dot(_mv(_sym_inverse(s), innovation))
+
+
 def _quat_from_matrix(m) -> Quat:
     """The unit quaternion (w ≥ 0) of a rotation matrix (rows of scalars; body → NED), Shepperd's method:
     the candidate built on the largest of 4w², 4x², 4y², 4z²."""

@@ -24,12 +24,13 @@ from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass, static_field, tree_where
 from ..sensors.avionics import Avionics, Bus, to_body
 from .attitude_filter import (
-    AttitudeEstimate, AttitudeTuning, attitude_error_b, attitude_nees, initial_attitude, magnetometer_update, propagate_attitude,
-    rotation_step, triad,
+    AttitudeEstimate, AttitudeTuning, attitude_error_b, attitude_nees, initial_attitude, magnetometer_nis, magnetometer_update,
+    propagate_attitude, rotation_step, triad,
 )  # fmt: skip
 from .guidance import Navigation
 from .position_filter import (
-    PositionEstimate, PositionTuning, altitude_update, gnss_update, initial_position, position_nees, propagate_position,
+    PositionEstimate, PositionTuning, altitude_nis, altitude_update, gnss_nis, gnss_update, initial_position, position_nees,
+    propagate_position,
 )  # fmt: skip
 
 LIFTOFF_SPECIFIC_FORCE_MPS2 = 2.0 * G0
@@ -86,7 +87,8 @@ class FilterParams:
     ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
     the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD (0:
     from the rail; static); horizontal_only: GNSS updates of north and east only (static); barometer: the
-    barometric height update (static)."""
+    barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
+    magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off; static)."""
 
     attitude: AttitudeTuning
     position: PositionTuning
@@ -96,6 +98,9 @@ class FilterParams:
     pad_samples: int = static_field(default=0)
     horizontal_only: bool = static_field(default=False)
     barometer: bool = static_field(default=False)
+    field_gate: float | None = static_field(default=None)
+    gnss_gate: float | None = static_field(default=None)
+    altitude_gate: float | None = static_field(default=None)
 
 
 @pytree_dataclass
@@ -106,7 +111,8 @@ class FilterState:
     magnetometer's samples [m/s², T, body frame] (their directions initialise TRIAD), of the barometer's [Pa] and
     their count (their mean is the pad pressure the barometric height is measured from), the GNC ticks on the pad;
     failed: a covariance was not finite or not positive (latched); errors: the estimation errors' totals
-    (``NavigationErrors``)."""
+    (``NavigationErrors``); rejected (3,): the fresh magnetometer, GNSS and barometer samples their innovation gates
+    rejected (counts)."""
 
     t: jnp.ndarray
     attitude: AttitudeEstimate
@@ -119,6 +125,7 @@ class FilterState:
     pad_ticks: jnp.ndarray
     failed: jnp.ndarray
     errors: NavigationErrors
+    rejected: jnp.ndarray
 
 
 @pytree_dataclass
@@ -152,13 +159,20 @@ def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterStat
     nan = zero + jnp.nan
     errors = NavigationErrors(zero, zero, zero, zero, zero, zero, zero, zero, nan, nan, nan, nan, nan)
     return FilterState(zero, initial_attitude(q_nb0, params.attitude), initial_position(r_n0, params.position),
-                       still, still, still, zero, zero, zero, jnp.zeros_like(zero, dtype=bool), errors)  # fmt: skip
+                       still, still, still, zero, zero, zero, jnp.zeros_like(zero, dtype=bool), errors,
+                       jnp.zeros((*zero.shape, 3), dtype=jnp.int32))  # fmt: skip
 
 
 def _reference_field(params: FilterParams, r_n: Vec3) -> Vec3:
     """The model's geomagnetic field at ``r_n`` [T, NED], to first order from the pad's."""
     g, r = params.field_gradient, (r_n.x, r_n.y, r_n.z)
     return Vec3(*(params.field_n[i] + sum(g[i, j] * r[j] for j in range(3)) for i in range(3)))
+
+
+def innovation_gate(gate: float | None, nis) -> jnp.ndarray:
+    """Whether an update is accepted by its χ² innovation gate: its normalised innovation squared eᵀ S⁻¹ e [-]
+    (``nis()``, evaluated only with a gate) at most ``gate`` [-]; always with no gate (None)."""
+    return jnp.asarray(True) if gate is None else nis() <= gate
 
 
 def _covariance_ok(state: FilterState):
@@ -206,8 +220,9 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     """The filters' solution at time t [s] from the measurements ``m``. Position and velocity are propagated from the
     last solution with the accelerometer's sample then (rotated into NED by the attitude then, plus gravity), the
     attitude with the gyroscope's rates then; the magnetometer updates the attitude, the GNSS (after
-    ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh. On the pad (``moving``
-    False: liftoff not yet sensed) the pad sums grow; after ``pad_samples`` ticks there TRIAD sets the attitude.
+    ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh (and accepted by its gate,
+    ``innovation_gate``; the rejections counted). On the pad (``moving`` False: liftoff not yet sensed) the pad sums
+    grow; after ``pad_samples`` ticks there TRIAD sets the attitude.
     ``idle`` (a parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
     solution (body rates: the gyroscope's less the estimated bias) and the new state (its ``errors`` untouched:
     ``track_errors``)."""
@@ -216,7 +231,9 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     position = propagate_position(state.position, acceleration_n, dt, params.position)
     attitude = propagate_attitude(state.attitude, state.omega_measured_b, dt, params.attitude)
     reference = _reference_field(params, position.r_n)
-    attitude = tree_where(m.field_fresh, magnetometer_update(attitude, m.field_b, reference, params.attitude), attitude)
+    field_ok = innovation_gate(params.field_gate, lambda: magnetometer_nis(attitude, m.field_b, reference, params.attitude))
+    attitude = tree_where(m.field_fresh & field_ok, magnetometer_update(attitude, m.field_b, reference, params.attitude),
+                          attitude)  # fmt: skip
 
     on_pad = ~moving
     pad_ticks = state.pad_ticks + on_pad
@@ -230,18 +247,23 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
                               attitude)  # fmt: skip
 
     fix = (t >= params.gnss_after_s) & m.gnss_fresh
-    fixed = gnss_update(position, Vec3(*(m.gnss[i] for i in range(3))), Vec3(*(m.gnss[3 + i] for i in range(3))),
-                        params.position, params.horizontal_only)  # fmt: skip
-    position = tree_where(fix, fixed, position)
+    gnss_r, gnss_v = Vec3(*(m.gnss[i] for i in range(3))), Vec3(*(m.gnss[3 + i] for i in range(3)))
+    gnss_ok = innovation_gate(params.gnss_gate, lambda: gnss_nis(position, gnss_r, gnss_v, params.position,
+                                                                 params.horizontal_only))  # fmt: skip
+    fixed = gnss_update(position, gnss_r, gnss_v, params.position, params.horizontal_only)
+    position = tree_where(fix & gnss_ok, fixed, position)
+    use, height_ok = jnp.asarray(False), jnp.asarray(True)
     if params.barometer:
         pad_pressure = state.pad_pressure_sum / jnp.maximum(state.pad_pressure_count, 1)
         use = m.pressure_fresh & (state.pad_pressure_count > 0) & moving
         height = pressure_height_m(m.pressure, pad_pressure)
-        position = tree_where(use, altitude_update(position, height, params.position), position)
+        height_ok = innovation_gate(params.altitude_gate, lambda: altitude_nis(position, height, params.position))
+        position = tree_where(use & height_ok, altitude_update(position, height, params.position), position)
+    rejected = state.rejected + jnp.stack([m.field_fresh & ~field_ok, fix & ~gnss_ok, use & ~height_ok], axis=-1)
 
     omega_measured_b = tree_where(m.omega_valid, m.omega_b, Vec3(0.0, 0.0, 0.0))
     new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_pressure_sum,
-                      pad_pressure_count, pad_ticks, state.failed, state.errors)  # fmt: skip
+                      pad_pressure_count, pad_ticks, state.failed, state.errors, rejected)  # fmt: skip
     failing = ~_covariance_ok(new)
     new = tree_where(idle | state.failed | failing, dataclasses.replace(state, t=t), new)  # the last good estimates
     new = dataclasses.replace(new, failed=state.failed | failing)

@@ -150,6 +150,26 @@ def altitude_update(est: PositionEstimate, altitude_m, tuning: PositionTuning) -
     )
 
 
+def gnss_nis(est: PositionEstimate, position_n: Vec3, velocity_n: Vec3, tuning: PositionTuning,
+             horizontal_only: bool = False) -> jnp.ndarray:
+    """``gnss_update``'s normalised innovation squared [-]: the sum over its axes of eᵀ S⁻¹ e, e = (z_r − r, z_v − v),
+    S = P + R per axis, i.e. (s22 e_r² − 2 p_rv e_r e_v + s11 e_v²)/det S (χ² with 2 degrees of freedom per axis)."""
+    total = 0.0
+    for i in (0, 1) if horizontal_only else (0, 1, 2):
+        e_r, e_v = position_n[i] - est.r_n[i], velocity_n[i] - est.v_n[i]
+        s11, b = est.p_rr[i] + tuning.gnss_position_std[i] ** 2, est.p_rv[i]
+        s22 = est.p_vv[i] + tuning.gnss_velocity_std[i] ** 2
+        total = total + (s22 * e_r * e_r - 2.0 * b * e_r * e_v + s11 * e_v * e_v) / (s11 * s22 - b * b)
+    return total
+
+
+def altitude_nis(est: PositionEstimate, altitude_m, tuning: PositionTuning) -> jnp.ndarray:
+    """``altitude_update``'s normalised innovation squared e²/S [-], e = −h − r_D, S = p_rr + σ_h² (χ², 1 degree
+    of freedom)."""
+    e = -altitude_m - est.r_n.z
+    return e * e / (est.p_rr.z + tuning.altitude_std**2)
+
+
 def position_nees(est: PositionEstimate, r_true: Vec3, v_true: Vec3) -> jnp.ndarray:
     """Normalized estimation error squared eᵀ P⁻¹ e, e = estimate − truth (6 degrees of freedom): the sum over
     the axes of (p_vv e_r² − 2 p_rv e_r e_v + p_rr e_v²)/(p_rr p_vv − p_rv²) [-]."""
