@@ -48,7 +48,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     ``where`` describing the cluster) and write the result file."""
     from .analysis.ellipse import AreaConvergence
     from .campaign import ResultWriter
-    from .campaign.checks import stability_warnings
+    from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings, stability_warnings
     from .campaign.runner import chunking
 
     cfg = campaign.config
@@ -60,7 +60,8 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     if writer.already_complete:
         print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
         return 0
-    _warn(stability_warnings(campaign))
+    warnings = stability_warnings(campaign)
+    _warn(warnings)
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
     tty = sys.stderr.isatty() and not args.quiet
@@ -108,29 +109,17 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
         state = "converged" if convergence.converged else f"not converged within the {cfg.n_realizations} allowed"
         log(f"{state} at N = {n_rows}: the 95 % ellipse's area is {convergence.area_m2 / 1e6:.4g} km², its 95 % "
             f"bootstrap interval {100 * convergence.width:.2f} % of it wide (target {args.until_converged:g} %)")  # fmt: skip
-    writer.finish(n_rows)
+    validity = []
+
+    def kept_warnings(f):  # the gathered flights' aerodynamic validity, with the stability warnings, in the file
+        validity.extend(outputs_validity_warnings(campaign, {n: f["outputs"][n][()] for n in VALIDITY_OUTPUTS}))
+        return warnings + validity
+
+    writer.finish(n_rows, kept_warnings)
     rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
     log(f"wrote {out} ({flown} flights flown in this run{rate})")
-    _warn(_validity_warnings(campaign, out))
+    _warn(validity)
     return 0
-
-
-def _validity_warnings(campaign, path: Path) -> list[str]:
-    """``checks.aero_validity_warnings`` of the flights in the result file ``path``."""
-    import h5py
-    import numpy as np
-
-    from .campaign.checks import aero_validity_warnings
-    from .sim.flight import OUTSIDE_TABLES_QBAR_FRACTION
-
-    names = ("max_mach", "apogee_agl_m", "max_dynamic_pressure_pa", "max_dynamic_pressure_outside_aero_tables_pa")
-    with h5py.File(path, "r") as f:
-        outputs = {name: f[f"outputs/{name}"][()] for name in names}
-    top = lambda values: float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")  # noqa: E731
-    qbar = outputs["max_dynamic_pressure_pa"]
-    outside = int((outputs["max_dynamic_pressure_outside_aero_tables_pa"] > OUTSIDE_TABLES_QBAR_FRACTION * qbar).sum())
-    return aero_validity_warnings(campaign, top(outputs["max_mach"]),
-                                  top(outputs["apogee_agl_m"]) + campaign.config.site.altitude_m, outside)  # fmt: skip
 
 
 def _warn(lines: list[str]) -> None:
@@ -408,6 +397,7 @@ def _navigate(args) -> int:
 
 def _fly_one(args) -> int:
     from .analysis.flight_plots import plot_flight
+    from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings
     from .analysis.flight_record import (
         OUT_SUFFIXES, check_realization, flight_record, format_record, write_kml, write_series,
     )  # fmt: skip
@@ -426,6 +416,7 @@ def _fly_one(args) -> int:
     say(f"{campaign.config.name}: {which} (compiling, then flying)")
     record = flight_record(campaign, args.realization)
     print(format_record(record))
+    _warn(outputs_validity_warnings(campaign, {name: [record.summary[name]] for name in VALIDITY_OUTPUTS}))
     if out:
         say(f"wrote {write_series(record, out)}: {len(record.series)} samples")
     if kml:

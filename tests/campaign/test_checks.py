@@ -56,19 +56,15 @@ def test_the_subsonic_limit_holds_for_built_up_tables_only(lynx):
     assert len(lines) == 1 and "subsonic theory" in lines[0], lines
 
 
-def test_run_reads_the_flights_maxima_from_its_result_file(lynx, tmp_path):
-    """`run`'s check after flying: the file's largest Mach number and apogee, and the flights outside the tables
-    at more than 10 % of their own maximum dynamic pressure (here 2 of 3: 5 kPa of 40, 0.1 of 40 is not one)."""
-    import h5py
+def test_the_flights_maxima_and_outside_count_from_their_outputs(lynx):
+    """`run`'s check after flying (and `fly`'s): the flights' largest Mach number and apogee, and the flights
+    outside the tables at more than 10 % of their own maximum dynamic pressure (here 2 of 3: 5 kPa of 40, 0.1 of
+    40 is not one)."""
     import numpy as np
 
-    from rocketmc.cli import _validity_warnings
+    from rocketmc.campaign.checks import outputs_validity_warnings
 
-    path = tmp_path / "run.h5"
-    with h5py.File(path, "w") as f:
-        for name, values in {"max_mach": [0.5, 0.95, np.nan], "apogee_agl_m": [3000.0, 3100.0, np.nan],
-                             "max_dynamic_pressure_pa": [4e4, 4e4, 4e4],
-                             "max_dynamic_pressure_outside_aero_tables_pa": [5e3, 1e2, 2e4]}.items():  # fmt: skip
-            f[f"outputs/{name}"] = np.array(values)
-    lines = _validity_warnings(lynx, path)
+    lines = outputs_validity_warnings(lynx, {"max_mach": [0.5, 0.95, np.nan], "apogee_agl_m": [3000.0, 3100.0, np.nan],
+                                             "max_dynamic_pressure_pa": [4e4, 4e4, 4e4],
+                                             "max_dynamic_pressure_outside_aero_tables_pa": [5e3, 1e2, 2e4]})  # fmt: skip
     assert any("Mach 0.95" in line for line in lines) and any(": 2 flight(s) left" in line for line in lines), lines

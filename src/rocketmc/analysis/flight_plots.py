@@ -33,6 +33,14 @@ def _events(axes, record: FlightRecord, until: float | None = None) -> None:
             ax.axvline(t, color=color, linestyle="--", linewidth=0.8, label=f"{name} ({t:.2f} s)" if k == 0 else None)
 
 
+def _finish(axes, record: FlightRecord, until: float | None = None, loc: str = "upper right") -> None:
+    """The events (``_events``), a legend and a light grid on each of the time-series ``axes``."""
+    _events(axes, record, until)
+    for ax in axes:
+        ax.legend(fontsize="small", loc=loc)
+        ax.grid(alpha=0.3)
+
+
 def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     """Write the ``FIGURES`` of ``record`` in ``directory`` (created if need be); returns their paths."""
     directory = Path(directory)
@@ -72,11 +80,7 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     ax_speed.plot(t, -s["v_down"], color="tab:green", linewidth=0.8, label="vertical speed (up)")
     ax_speed.set_ylabel("speed [m/s]")
     ax_speed.set_xlabel("time since the start on the rail [s]")
-    _events((ax_alt, ax_speed), record)
-    ax_alt.legend(fontsize="small", loc="upper right")
-    ax_speed.legend(fontsize="small", loc="upper right")
-    for a in (ax_alt, ax_speed):
-        a.grid(alpha=0.3)
+    _finish((ax_alt, ax_speed), record)
     ax_alt.set_title(f"{record.label}: altitude and speed")
     _save(fig, paths[1])
 
@@ -94,12 +98,9 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     ax_q.plot(shown["time"], shown["dynamic_pressure"] / 1000.0, color="tab:red", linewidth=0.8, label="dynamic pressure")
     ax_q.set_ylabel("dynamic pressure [kPa]", color="tab:red")
     ax_mach.set_xlabel("time since the start on the rail [s]")
-    _events((ax_angles, ax_mach), record, end)
-    ax_angles.legend(fontsize="small", loc="upper right")
+    _finish((ax_angles, ax_mach), record, end)
     lines = ax_mach.get_legend_handles_labels()[0] + ax_q.get_legend_handles_labels()[0]
-    ax_mach.legend(lines, [h.get_label() for h in lines], fontsize="small", loc="upper right")
-    for a in (ax_angles, ax_mach):
-        a.grid(alpha=0.3)
+    ax_mach.legend(lines, [h.get_label() for h in lines], fontsize="small", loc="upper right")  # with the twin's line
     ax_angles.set_title(f"{record.label}: angles of attack, rail exit to apogee\n"
                         "(air-relative velocity: mean wind and gust)")  # fmt: skip
     _save(fig, paths[2])
@@ -113,11 +114,7 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     ax_position.set_ylabel("distance from the nose tip [m]")
     ax_position.invert_yaxis()  # the nose on top, the tail below
     ax_position.set_xlabel("time since the start on the rail [s]")
-    _events((ax_margin, ax_position), record, m["apogee_time_s"])
-    ax_margin.legend(fontsize="small", loc="lower right")
-    ax_position.legend(fontsize="small", loc="lower right")
-    for a in (ax_margin, ax_position):
-        a.grid(alpha=0.3)
+    _finish((ax_margin, ax_position), record, end, loc="lower right")
     ax_margin.set_title(f"{record.label}: static stability, rail exit to apogee")
     _save(fig, paths[3])
     return paths

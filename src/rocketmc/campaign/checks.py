@@ -75,3 +75,19 @@ def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: 
                      f"sideslip, Mach or altitude) at more than {OUTSIDE_TABLES_QBAR_FRACTION:.0%} of their maximum "
                      "dynamic pressure")  # fmt: skip
     return lines
+
+
+VALIDITY_OUTPUTS = ("max_mach", "apogee_agl_m", "max_dynamic_pressure_pa", "max_dynamic_pressure_outside_aero_tables_pa")
+"""The per-flight outputs ``outputs_validity_warnings`` reads."""
+
+
+def outputs_validity_warnings(campaign: Campaign, outputs) -> list[str]:
+    """``aero_validity_warnings`` of flights given by their ``outputs`` (``VALIDITY_OUTPUTS``' names to one value
+    per flight: a result file's /outputs or one flight's summary): the largest Mach number and altitude flown,
+    and how many flights were outside the tables by status 3's criterion."""
+    top = lambda values: float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")  # noqa: E731
+    values = {name: np.asarray(outputs[name], float) for name in VALIDITY_OUTPUTS}
+    qbar = values["max_dynamic_pressure_pa"]
+    outside = int((values["max_dynamic_pressure_outside_aero_tables_pa"] > OUTSIDE_TABLES_QBAR_FRACTION * qbar).sum())
+    return aero_validity_warnings(campaign, top(values["max_mach"]),
+                                  top(values["apogee_agl_m"]) + campaign.config.site.altitude_m, outside)  # fmt: skip

@@ -206,10 +206,11 @@ class ResultWriter:
         with h5py.File(self._chunk_path(index), "r") as chunk:
             return {name: chunk["outputs"][name][()] for name in names}
 
-    def finish(self, n_rows: int | None = None) -> Path:
+    def finish(self, n_rows: int | None = None, warnings=None) -> Path:
         """Check the chunks and gather them into ``<out>`` (complete), then remove the partial folder.
         ``n_rows``: the realizations kept when a run stopped early (``--until-converged``), the first
-        chunks' rows."""
+        chunks' rows; ``warnings``: a function of the gathered file returning warning lines, kept in its
+        ``warnings`` attribute (a JSON list) before the file is marked complete."""
         if self.already_complete:
             return self.out
         n = self.n if n_rows is None else n_rows
@@ -235,6 +236,8 @@ class ResultWriter:
                         for name, values in data.items():
                             values = values[: max(0, n - start)]
                             self._dataset(f, group, name, values, n)[start : start + len(values)] = values
+                if warnings is not None:
+                    f.attrs["warnings"] = json.dumps(warnings(f))
                 f.attrs["complete"] = True
         except OSError as e:
             raise WriteError(f"{self.out}: could not write ({e.strerror or e}); all {_plural(len(needed), 'chunk')} are "
