@@ -177,3 +177,19 @@ def test_help_matches_the_readme(capsys):
         for option, values in choices.items():
             shown = re.search(r"\{([^}]*)\}" if option is None else re.escape(option) + r" \{([^}]*)\}", text)
             assert shown and set(shown.group(1).split(",")) == values, (words, option)
+
+
+def test_report_of_an_unstable_rocket(tmp_path, capsys):
+    """Acceptance (issue 19): campaigns/unstable_rocket.toml (no fins) tumbles; report shows its impacts,
+    counts and statuses: every flight failed with status 3, each with an impact point, drawn apart."""
+    out, png = tmp_path / "unstable.h5", tmp_path / "unstable.png"
+    assert main(["run", str(CAMPAIGNS / "unstable_rocket.toml"), "-n", "8", "--out", str(out), "--quiet"]) == 0
+    assert main(["report", str(out), "--json", "--plot", str(png)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n_ok"] == 0 and summary["impact_ellipses"] == []
+    assert summary["failed"] == [{"code": 3, "message": summary["failed"][0]["message"], "count": 8, "landed": 8,
+                                  "no_impact_point": 0}]  # fmt: skip
+    assert png.stat().st_size > 10_000
+    assert main(["report", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "Failed realizations" in text and "Realizations: 8 total, 0 ok" in text

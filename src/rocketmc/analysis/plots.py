@@ -14,8 +14,14 @@ from .ellipse import Ellipse, confidence_ellipse
 from .results import Run
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")
+_FAILED_MARKERS = ("x", "+", "1", "s", "D")
 _RUN_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
                "tab:olive", "tab:cyan")  # fmt: skip
+
+
+def _shorten(text: str, width: int = 40) -> str:
+    """``text`` cut to ``width`` characters with an ellipsis (a legend entry on one line)."""
+    return text if len(text) <= width else text[: width - 1] + "…"
 
 
 def _area_label(area_m2: float) -> str:
@@ -34,7 +40,8 @@ def plot_impacts(
     """Impact points of ok realizations with their confidence ellipses.
 
     East [m] on the x axis, north [m] on the y axis, equal aspect; the pad (origin) and the
-    mean impact point are marked. Failed realizations are not drawn but counted in the title;
+    mean impact point are marked. Failed realizations that landed are drawn apart, one marker per
+    status, and counted in the legend (those without an impact point only counted in the title);
     ellipses are omitted when fewer than 3 ok impact points exist. Draws on ``ax`` if given
     (else on a new figure, without pyplot) and saves to ``path`` (PNG at 150 dpi) if given.
     """
@@ -43,7 +50,15 @@ def plot_impacts(
     n_total = len(run.outputs)
     n_ok = int(run.ok.sum())
 
-    _scatter(ax, north, east, "tab:blue", label="impacts")
+    _scatter(ax, north, east, "tab:blue", label=f"ok impacts ({n_ok})")
+    status = run.outputs["status"].to_numpy()
+    for i, code in enumerate(sorted(set(status[~run.ok].tolist()))):
+        where = run.has_impact & (status == code)
+        if where.any():
+            f_north, f_east = run.ok_impacts(where)
+            ax.scatter(f_east, f_north, s=22, marker=_FAILED_MARKERS[i % len(_FAILED_MARKERS)], color="k",
+                       linewidths=1.0, label=f"status {code} ({int(where.sum())} landed): "
+                       f"{_shorten(run.status_codes.get(code, 'unknown'))}", zorder=5)  # fmt: skip
     ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
     if north.size >= 3:
         for i, level in enumerate(levels):
@@ -52,8 +67,10 @@ def plot_impacts(
         ax.plot(east.mean(), north.mean(), "kX", markersize=9, label="mean impact", zorder=4)
 
     title = f"{run.attrs.get('campaign_name', '')}: impact points, {n_ok} ok / {n_total}"
+    missing = int((~run.ok & ~run.has_impact).sum())
+    title += f", seed {run.attrs.get('seed')}"
     if n_ok < n_total:
-        title += f"\n({n_total - n_ok} failed realizations not shown)"
+        title += f"\n{n_total - n_ok} failed (not in the ellipses), {missing} of them without an impact point"
     _finish(fig, ax, title, path)
     return fig
 

@@ -56,6 +56,12 @@ class Run:
         """Boolean mask of ok realizations with finite impact coordinates."""
         return self.ok & np.isfinite(self._impacts()).all(axis=0)
 
+    @property
+    def has_impact(self) -> np.ndarray:
+        """Boolean mask of realizations, of any status, with finite impact coordinates (a tumbled flight
+        still lands; one stopped on a NaN state has no impact point)."""
+        return np.isfinite(self._impacts()).all(axis=0)
+
     def _impacts(self) -> np.ndarray:
         """(2, N) impact points (north, east) [m] of every realization."""
         return self.outputs[["impact_north_m", "impact_east_m"]].to_numpy(dtype=float).T
@@ -178,7 +184,9 @@ def summarize(run: Run) -> dict:
     """JSON-serialisable summary of a run.
 
     Keys: ``campaign_name``, ``seed``, ``rocketmc_version``, ``n_realizations``, ``n_ok``,
-    ``status`` (list of code/message/count, every known code and any other code seen),
+    ``status`` (list of code/message/count, every known code and any other code seen), ``failed`` (per
+    code seen other than 0: code, message, count, ``landed`` with an impact point and
+    ``no_impact_point``; these flights are left out of the metrics and ellipses),
     ``metrics`` (per output except status, over ok realizations and finite values: unit, n,
     mean, std (ddof=1), min, p5, p50, p95, max) and ``impact_ellipses`` (``Ellipse.to_dict()``
     at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
@@ -198,6 +206,12 @@ def summarize(run: Run) -> dict:
         }
         for c in codes
     ]
+    failed = [
+        {"code": s["code"], "message": s["message"], "count": s["count"],
+         "landed": int((run.has_impact & (status == s["code"])).sum()),
+         "no_impact_point": int((~run.has_impact & (status == s["code"])).sum())}
+        for s in status_rows if s["code"] != 0 and s["count"]
+    ]  # fmt: skip
     metrics = {
         name: {"unit": run.units.get(name, ""), **_metric_stats(col.to_numpy(dtype=float)[ok])}
         for name, col in run.outputs.items()
@@ -217,6 +231,7 @@ def summarize(run: Run) -> dict:
         "n_realizations": len(run.outputs),
         "n_ok": int(ok.sum()),
         "status": status_rows,
+        "failed": failed,
         "metrics": metrics,
         "impact_ellipses": ellipses,
         "impact_ellipse_95_intervals": intervals,
@@ -263,8 +278,17 @@ def format_summary(summary: dict) -> str:
             align="rrl",
         ),
         "",
-        "Metrics (ok realizations)",
     ]
+    if summary["failed"]:
+        out += ["Failed realizations (not in the metrics or ellipses; their impact points are drawn apart)"]
+        out += _table(
+            ["code", "count", "landed", "no impact point", "message"],
+            [[str(s["code"]), str(s["count"]), str(s["landed"]), str(s["no_impact_point"]), s["message"]]
+             for s in summary["failed"]],
+            align="rrrrl",
+        )  # fmt: skip
+        out.append("")
+    out += ["Metrics (ok realizations)"]
     stat_keys = ["mean", "std", "min", *_PERCENTILES, "max"]
     out += _table(
         ["metric", "unit", "n", *stat_keys],
