@@ -193,3 +193,12 @@ def test_report_of_an_unstable_rocket(tmp_path, capsys):
     assert main(["report", str(out)]) == 0
     text = capsys.readouterr().out
     assert "Failed realizations" in text and "Realizations: 8 total, 0 ok" in text
+
+
+def test_report_outside_radius(small_run, capsys):
+    assert main(["report", str(small_run), "--json", "--outside-radius", "1e7"]) == 0
+    result = json.loads(capsys.readouterr().out)["outside_radius"]
+    assert result["outside"] == 0 and result["n"] == 6 and result["upper_bound_none_outside"] > 0.39
+    with pytest.raises(SystemExit) as info:
+        main(["report", str(small_run), "--outside-radius", "-5"])
+    assert info.value.code == 2 and "--outside-radius" in capsys.readouterr().err

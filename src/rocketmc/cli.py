@@ -117,7 +117,14 @@ def _report(args) -> int:
     maps = [_output_file("--map", path, MAP_SUFFIXES) for path in args.map or []]
     run = load_run(args.file)
     summary = summarize(run)
-    print(json.dumps(summary, indent=2, allow_nan=False) if args.json else format_summary(summary))
+    if args.outside_radius is not None:
+        from .analysis.safety import format_outside, outside_radius
+
+        summary["outside_radius"] = outside_radius(run, args.outside_radius)
+    text = format_summary(summary)
+    if "outside_radius" in summary:
+        text += "\n\n" + format_outside(summary["outside_radius"])
+    print(json.dumps(summary, indent=2, allow_nan=False) if args.json else text)
     if plot:
         plot_impacts(run, path=plot)
         print(f"wrote {plot}", file=sys.stderr)
@@ -456,6 +463,9 @@ def main(argv: list[str] | None = None) -> int:
     report.add_argument("--map", action="append", metavar="FILE",
                         help="write the impact points and ellipses around the launch site as KML (.kml) or "
                              "GeoJSON (.geojson); repeatable")  # fmt: skip
+    report.add_argument("--outside-radius", type=float, metavar="M",
+                        help="the probability of landing more than M metres from the pad, with its exact 95 %% "
+                             "interval (flights without an impact point counted as outside)")  # fmt: skip
     compare = commands.add_parser("compare", help="compare the landing dispersion of result files with the first's")
     compare.add_argument("files", nargs="+", metavar="FILE",
                          help="HDF5 result files, at least two; the first is the baseline")  # fmt: skip
@@ -536,6 +546,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--n must be at least 1")
     if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
         parser.error("--until-converged must be a percentage in (0, 100]")
+    if getattr(args, "outside_radius", None) is not None and not 0 < args.outside_radius < float("inf"):
+        parser.error("--outside-radius must be a positive distance in metres")
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
     for name in ("n", "chunk_size", "workers"):
