@@ -202,3 +202,20 @@ def test_report_outside_radius(small_run, capsys):
     with pytest.raises(SystemExit) as info:
         main(["report", str(small_run), "--outside-radius", "-5"])
     assert info.value.code == 2 and "--outside-radius" in capsys.readouterr().err
+
+
+def test_report_csv(small_run, tmp_path, capsys):
+    """One row per realization, status first, columns with units; values as in the result file."""
+    import pandas as pd
+
+    csv = tmp_path / "run.csv"
+    assert main(["report", str(small_run), "--csv", str(csv)]) == 0
+    table = pd.read_csv(csv, index_col="realization")
+    with h5py.File(small_run) as f:
+        assert list(table["status"]) == list(f["outputs/status"][:])
+        np.testing.assert_array_equal(table["impact_north_m [m]"], f["outputs/impact_north_m"][:])  # repr round-trips
+        np.testing.assert_array_equal(table["input: launch.azimuth_deg"], f["inputs/launch.azimuth_deg"][:])
+    assert len(table) == 6
+    capsys.readouterr()
+    assert main(["report", str(small_run), "--csv", str(tmp_path / "run.txt")]) == 2
+    assert "--csv" in capsys.readouterr().err and not (tmp_path / "run.txt").exists()

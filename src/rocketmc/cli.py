@@ -115,6 +115,7 @@ def _report(args) -> int:
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     maps = [_output_file("--map", path, MAP_SUFFIXES) for path in args.map or []]
+    csv = None if args.csv is None else _output_file("--csv", args.csv, (".csv",))
     run = load_run(args.file)
     summary = summarize(run)
     if args.outside_radius is not None:
@@ -130,6 +131,10 @@ def _report(args) -> int:
         print(f"wrote {plot}", file=sys.stderr)
     for path in maps:
         print(f"wrote {write_map(run, path)}", file=sys.stderr)
+    if csv:
+        from .analysis.export import write_csv
+
+        print(f"wrote {write_csv(run, csv)}", file=sys.stderr)
     return 0
 
 
@@ -463,6 +468,8 @@ def main(argv: list[str] | None = None) -> int:
     report.add_argument("--map", action="append", metavar="FILE",
                         help="write the impact points and ellipses around the launch site as KML (.kml) or "
                              "GeoJSON (.geojson); repeatable")  # fmt: skip
+    report.add_argument("--csv", metavar="FILE",
+                        help="write one row per realization (status, outputs, inputs; columns with units) to this CSV")
     report.add_argument("--outside-radius", type=float, metavar="M",
                         help="the probability of landing more than M metres from the pad, with its exact 95 %% "
                              "interval (flights without an impact point counted as outside)")  # fmt: skip

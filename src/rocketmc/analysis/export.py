@@ -111,6 +111,27 @@ def to_kml(run: Run, levels=SUMMARY_LEVELS) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ElementTree.tostring(kml, encoding="unicode") + "\n"
 
 
+def to_csv_frame(run: Run):
+    """One row per realization: its index, status and every output then input, columns named
+    ``name [unit]`` (inputs ``input: dotted path [unit]``); NaN where an event did not happen."""
+    def label(name, prefix=""):
+        unit = run.units.get(name, "")
+        return f"{prefix}{name}" + (f" [{unit}]" if unit else "")
+
+    outputs = run.outputs.drop(columns="status").rename(columns=label)
+    inputs = run.inputs.rename(columns=lambda name: label(name, "input: "))
+    frame = outputs.join(inputs) if len(inputs.columns) else outputs
+    frame.insert(0, "status", run.outputs["status"].to_numpy())
+    return frame
+
+
+def write_csv(run: Run, path: str | Path) -> Path:
+    """Write :func:`to_csv_frame` to ``path`` (written under a temporary name and renamed)."""
+    with replacing(path) as partial:
+        to_csv_frame(run).to_csv(partial, index_label="realization")
+    return Path(path)
+
+
 def write_map(run: Run, path: str | Path) -> Path:
     """Write ``to_kml`` (``.kml``) or ``to_geojson`` (``.geojson``/``.json``) by the file's suffix."""
     path = Path(path)
