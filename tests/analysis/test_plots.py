@@ -49,11 +49,13 @@ def _ellipse_lines(ax):
 def test_title_labels_and_points():
     run = _run()
     ax = plot_impacts(run).axes[0]
-    title = f"plot-test: impact points, {N - N_FAILED} ok / {N}\n({N_FAILED} failed realizations not shown)"
+    title = (f"plot-test: impact points, {N - N_FAILED} ok / {N}, seed 1\n{N_FAILED} failed (not in the ellipses), "
+             f"{min(5, N_FAILED)} of them without an impact point")  # fmt: skip
     assert ax.get_title() == title
     assert ax.get_xlabel() == "east of pad [m]" and ax.get_ylabel() == "north of pad [m]"
     north, east = _ok_points(run)
-    (scatter,) = ax.collections
+    scatter, failed = ax.collections  # the failed flights that landed drawn apart
+    assert np.asarray(failed.get_offsets()).shape == (N_FAILED - 5, 2) and "status 1" in failed.get_label()
     offsets = np.asarray(scatter.get_offsets())
     assert offsets.shape == (N - N_FAILED, 2)  # every ok point once, no failed one
     np.testing.assert_array_equal(offsets, np.column_stack([east, north]))  # east on x, north on y
@@ -63,7 +65,8 @@ def test_title_labels_and_points():
     np.testing.assert_allclose([mean.get_xdata()[0], mean.get_ydata()[0]], [east.mean(), north.mean()], rtol=1e-12)
     assert ax.get_aspect() == 1.0  # equal aspect: the ellipses are not distorted
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert legend[:2] == ["impacts", "pad"] and legend[-1] == "mean impact"
+    assert legend[0] == f"ok impacts ({N - N_FAILED})" and legend[1].startswith("status 1 (2 landed)")
+    assert legend[2] == "pad" and legend[-1] == "mean impact"
 
 
 def test_ellipses_have_the_sample_centre_and_semi_axes():
@@ -87,7 +90,9 @@ def test_ellipses_have_the_sample_centre_and_semi_axes():
         np.testing.assert_allclose(xy.max(axis=0), half_widths, rtol=2e-4)
         np.testing.assert_allclose(-xy.min(axis=0), half_widths, rtol=2e-4)
         area_km2 = np.pi * k2 * np.sqrt(np.linalg.det(sigma)) / 1e6
-        assert line.get_label() == f"{100 * level:g} % ellipse ({area_km2:.3g} km²)"
+        inside = np.mean(np.einsum("ni,ij,nj->n", np.column_stack(_ok_points(run)[::-1]) - mu, np.linalg.inv(sigma),
+                                   np.column_stack(_ok_points(run)[::-1]) - mu) <= k2)  # fmt: skip
+        assert line.get_label() == f"{100 * level:g} % ellipse, {100 * inside:.1f} % inside ({area_km2:.3g} km²)"
         assert to_rgb(line.get_color()) == to_rgb(color)
 
 
@@ -95,10 +100,10 @@ def test_all_ok_and_too_few_points():
     """No failure line in the title when every flight is ok; with fewer than 3 ok points no ellipse
     and no mean marker (a covariance needs 3), the points still drawn."""
     ax = plot_impacts(_run(n_failed=0)).axes[0]
-    assert ax.get_title() == f"plot-test: impact points, {N} ok / {N}"
+    assert ax.get_title() == f"plot-test: impact points, {N} ok / {N}, seed 1"
     assert len(_ellipse_lines(ax)) == 3
     ax = plot_impacts(_run(n=10, n_failed=8)).axes[0]
-    assert ax.get_title().startswith("plot-test: impact points, 2 ok / 10\n(8 failed")
+    assert ax.get_title().startswith("plot-test: impact points, 2 ok / 10, seed 1\n8 failed")
     assert np.asarray(ax.collections[0].get_offsets()).shape == (2, 2)
     assert _ellipse_lines(ax) == [] and "mean impact" not in [line.get_label() for line in ax.lines]
 

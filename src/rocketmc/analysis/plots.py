@@ -62,8 +62,12 @@ def plot_impacts(
     ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
     if north.size >= 3:
         for i, level in enumerate(levels):
-            _ellipse(ax, confidence_ellipse(north, east, level), _ELLIPSE_COLORS[i % len(_ELLIPSE_COLORS)],
-                     f"{100 * level:g} % ellipse")  # fmt: skip
+            ellipse = confidence_ellipse(north, east, level)
+            _ellipse(ax, ellipse, _ELLIPSE_COLORS[i % len(_ELLIPSE_COLORS)],
+                     f"{100 * level:g} % ellipse, {100 * ellipse.contains(north, east).mean():.1f} % inside")  # fmt: skip
+        ax.text(0.01, 0.01, "ellipses: a Gaussian fit to the ok impact points (sample mean and covariance);\n"
+                "'inside' is the fraction of ok points each actually holds", transform=ax.transAxes,
+                fontsize="small", va="bottom", ha="left", bbox={"facecolor": "white", "alpha": 0.8, "linewidth": 0})
         ax.plot(east.mean(), north.mean(), "kX", markersize=9, label="mean impact", zorder=4)
 
     title = f"{run.attrs.get('campaign_name', '')}: impact points, {n_ok} ok / {n_total}"

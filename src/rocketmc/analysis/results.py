@@ -218,11 +218,10 @@ def summarize(run: Run) -> dict:
         if name != "status"
     }
     north, east = run.ok_impacts()
-    ellipses = (
-        [confidence_ellipse(north, east, level).to_dict() for level in SUMMARY_LEVELS]
-        if north.size >= 3
-        else []
-    )
+    ellipses = [
+        {**e.to_dict(), "coverage": float(e.contains(north, east).mean())}
+        for e in (confidence_ellipse(north, east, level) for level in SUMMARY_LEVELS)
+    ] if north.size >= 3 else []  # fmt: skip
     intervals = bootstrap_intervals(north, east, 0.95) if north.size >= MIN_BOOTSTRAP_POINTS else None
     return {
         "campaign_name": run.attrs.get("campaign_name", ""),
@@ -301,7 +300,7 @@ def format_summary(summary: dict) -> str:
     out += ["", "Impact ellipses (north/east from pad)"]
     if summary["impact_ellipses"]:
         out += _table(
-            ["level", "N [m]", "E [m]", "a [m]", "b [m]", "az [deg]", "area [km^2]", "area [m^2]"],
+            ["level", "N [m]", "E [m]", "a [m]", "b [m]", "az [deg]", "area [km^2]", "area [m^2]", "inside"],
             [
                 [
                     f"{100 * e['level']:g} %",
@@ -312,12 +311,14 @@ def format_summary(summary: dict) -> str:
                     f"{e['orientation_deg']:.1f}",
                     f"{e['area_m2'] / 1e6:.4g}",
                     f"{e['area_m2']:.0f}",
+                    f"{100 * e['coverage']:.1f} %",
                 ]
                 for e in summary["impact_ellipses"]
             ],
-            align="r" * 8,
+            align="r" * 9,
         )
-        out.append("  (N, E: centre; a, b: semi-axes; az: major axis, clockwise from north)")
+        out.append("  (N, E: centre; a, b: semi-axes; az: major axis, clockwise from north; inside: the fraction of "
+                   "ok impact points inside, the check on the ellipses' Gaussian fit)")  # fmt: skip
     if summary["impact_ellipse_95_intervals"]:
         i = summary["impact_ellipse_95_intervals"]
         out.append(f"  95 % ellipse, 95 % bootstrap intervals: area {i['area_m2'][0] / 1e6:.4g}–{i['area_m2'][1] / 1e6:.4g} "
