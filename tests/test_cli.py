@@ -219,3 +219,19 @@ def test_report_csv(small_run, tmp_path, capsys):
     capsys.readouterr()
     assert main(["report", str(small_run), "--csv", str(tmp_path / "run.txt")]) == 2
     assert "--csv" in capsys.readouterr().err and not (tmp_path / "run.txt").exists()
+
+
+def test_report_maps_of_failed_flights(tmp_path, capsys):
+    """The failed flights that landed are on the maps apart, with their status (a crafted file: no flight)."""
+    from .test_cli_errors import write_result
+
+    status = np.zeros(50, np.int32)
+    status[:4] = 3
+    result = write_result(tmp_path / "run.h5", status=status)
+    with h5py.File(result, "r+") as f:
+        f["outputs/status"].attrs["codes"] = json.dumps({"0": "ok", "3": "tumbled"})
+    geojson, kml = tmp_path / "m.geojson", tmp_path / "m.kml"
+    assert main(["report", str(result), "--map", str(geojson), "--map", str(kml)]) == 0
+    failed = [x for x in json.loads(geojson.read_text())["features"] if x["properties"].get("status") == 3]
+    assert len(failed) == 1 and failed[0]["properties"]["count"] == 4 and failed[0]["properties"]["message"] == "tumbled"
+    assert "status 3 (4 landed): tumbled" in kml.read_text()

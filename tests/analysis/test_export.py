@@ -44,11 +44,12 @@ def test_geojson_is_valid_and_ellipses_lie_on_the_ellipse(run):
     data = json.loads(json.dumps(to_geojson(run)))  # plain JSON types only
     assert data["type"] == "FeatureCollection"
     kinds = [f["geometry"]["type"] for f in data["features"]]
-    assert kinds == ["Point", "MultiPoint", "Polygon", "Polygon", "Polygon"]
+    assert kinds == ["Point", "MultiPoint", "Polygon", "Polygon", "Polygon", "MultiPoint"]  # the failed flights last
     assert data["features"][0]["geometry"]["coordinates"] == [SITE[1], SITE[0]]  # [longitude, latitude]
     assert len(data["features"][1]["geometry"]["coordinates"]) == 493  # the ok impacts
+    assert data["features"][5]["properties"]["status"] == 2 and data["features"][5]["properties"]["count"] == 7  # the landed failures
     north, east = run.ok_impacts()
-    for feature in data["features"][2:]:
+    for feature in data["features"][2:5]:
         assert feature["type"] == "Feature" and "properties" in feature
         (ring,) = feature["geometry"]["coordinates"]
         assert len(ring) >= 4 and ring[0] == ring[-1]  # RFC 7946 §3.1.6: closed linear ring
@@ -76,7 +77,8 @@ def test_kml_parses_and_follows_the_schema_order(run):
     for ring in rings:
         points = [tuple(map(float, p.split(","))) for p in ring.text.split()]
         assert points[0] == points[-1] and all(len(p) == 3 for p in points)
-    assert len(document.findall("k:Folder/k:Placemark/k:Point", ns)) == 493
+    assert len(document.findall("k:Folder/k:Placemark/k:Point", ns)) == 500  # 493 ok impacts, the failed landed apart
+    assert len(document.findall("k:Folder", ns)[0].findall("k:Placemark", ns)) == 493
     for mark in document.iter(f"{{{KML_NAMESPACE}}}Placemark"):
         children = [c.tag.split("}")[1] for c in mark]
         assert children[0] == "name" and children[-1] in ("Point", "Polygon")  # styleUrl before the geometry

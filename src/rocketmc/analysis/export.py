@@ -32,7 +32,8 @@ def _site(run: Run) -> tuple[str, float, float]:
 
 def map_features(run: Run, levels=SUMMARY_LEVELS) -> dict:
     """The pad, the ok impact points and the ``levels`` ellipses as lists of (longitude, latitude)
-    [deg]: ``{"site": name, "pad": (lon, lat), "impacts": [(lon, lat), ...], "ellipses": {level: ring}}``;
+    [deg]: ``{"site": name, "pad": (lon, lat), "impacts": [(lon, lat), ...], "ellipses": {level: ring},
+    "failed": {status code: [(lon, lat), ...]}}`` (the failed flights that landed, apart, per status);
     each ring is closed (last point = first) and counterclockwise seen from above."""
     name, lat0, lon0 = _site(run)
     north, east = run.ok_impacts()
@@ -47,7 +48,13 @@ def map_features(run: Run, levels=SUMMARY_LEVELS) -> dict:
             if _signed_area(ring) < 0:  # RFC 7946: exterior rings counterclockwise
                 ring = ring[::-1]
             ellipses[level] = [*ring, ring[0]]
-    return {"site": name, "pad": (lon0, lat0), "impacts": list(zip(lon.tolist(), lat.tolist())), "ellipses": ellipses}
+    status = run.outputs["status"].to_numpy()
+    failed = {}
+    for code in sorted(set(status[~run.ok].tolist())):
+        f_lat, f_lon = latitude_longitude_deg(*run.ok_impacts(run.has_impact & (status == code)), lat0, lon0)
+        failed[code] = list(zip(f_lon.tolist(), f_lat.tolist()))
+    return {"site": name, "pad": (lon0, lat0), "impacts": list(zip(lon.tolist(), lat.tolist())), "ellipses": ellipses,
+            "failed": failed}  # fmt: skip
 
 
 def _signed_area(ring) -> float:
@@ -69,6 +76,11 @@ def to_geojson(run: Run, levels=SUMMARY_LEVELS) -> dict:
         {"type": "Feature", "geometry": {"type": "Polygon", "coordinates": [[list(p) for p in ring]]},
          "properties": {"name": f"{name}: {100 * level:g} % impact ellipse", "level": level}}
         for level, ring in f["ellipses"].items()
+    ] + [
+        {"type": "Feature", "geometry": {"type": "MultiPoint", "coordinates": [list(p) for p in points]},
+         "properties": {"name": f"{name}: failed flights, status {code}", "status": code,
+                        "message": run.status_codes.get(code, "unknown"), "count": len(points)}}
+        for code, points in f["failed"].items()
     ]  # fmt: skip
     return {"type": "FeatureCollection", "features": features}
 
@@ -107,6 +119,12 @@ def to_kml(run: Run, levels=SUMMARY_LEVELS) -> str:
     ElementTree.SubElement(folder, q("name")).text = f"impact points ({len(f['impacts'])})"
     for k, position in enumerate(f["impacts"]):
         coordinates(placemark(folder, f"impact {k}", "Point"), [position])
+    for code, points in f["failed"].items():
+        folder = ElementTree.SubElement(document, q("Folder"))
+        ElementTree.SubElement(folder, q("name")).text = (f"failed flights, status {code} ({len(points)} landed): "
+                                                          f"{run.status_codes.get(code, 'unknown')}")  # fmt: skip
+        for k, position in enumerate(points):
+            coordinates(placemark(folder, f"failed (status {code}) {k}", "Point"), [position])
     ElementTree.indent(kml)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ElementTree.tostring(kml, encoding="unicode") + "\n"
 
