@@ -235,3 +235,17 @@ def test_report_maps_of_failed_flights(tmp_path, capsys):
     failed = [x for x in json.loads(geojson.read_text())["features"] if x["properties"].get("status") == 3]
     assert len(failed) == 1 and failed[0]["properties"]["count"] == 4 and failed[0]["properties"]["message"] == "tumbled"
     assert "status 3 (4 landed): tumbled" in kml.read_text()
+
+
+def test_report_plots(small_run, tmp_path, capsys):
+    """--plots DIR makes the folder and writes the three histograms; a file in its place: one line, exit 2."""
+    folder = tmp_path / "histograms"
+    assert main(["report", str(small_run), "--plots", str(folder)]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == ["apogee.png", "impact_distance.png", "landing_speed.png"]
+    capsys.readouterr()
+    (tmp_path / "taken").write_text("")
+    assert main(["report", str(small_run), "--plots", str(tmp_path / "taken")]) == 2
+    err = capsys.readouterr().err
+    assert "--plots" in err and len(err.splitlines()) == 1
+    assert main(["report", str(small_run), "--plots", str(tmp_path / "no" / "such")]) == 2
+    assert not (tmp_path / "no").exists()

@@ -116,6 +116,9 @@ def _report(args) -> int:
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     maps = [_output_file("--map", path, MAP_SUFFIXES) for path in args.map or []]
     csv = None if args.csv is None else _output_file("--csv", args.csv, (".csv",))
+    plots = None if args.plots is None else Path(args.plots)
+    if plots is not None and (plots.exists() and not plots.is_dir() or not plots.parent.is_dir()):
+        raise RocketmcError(f"--plots {plots}: expected a folder, or a new one's name in an existing folder")
     run = load_run(args.file)
     summary = summarize(run)
     if args.outside_radius is not None:
@@ -135,6 +138,12 @@ def _report(args) -> int:
         from .analysis.export import write_csv
 
         print(f"wrote {write_csv(run, csv)}", file=sys.stderr)
+    if plots is not None:
+        from .analysis.plots import plot_histograms
+
+        plots.mkdir(exist_ok=True)
+        for path in plot_histograms(run, plots):
+            print(f"wrote {path}", file=sys.stderr)
     return 0
 
 
@@ -470,6 +479,9 @@ def main(argv: list[str] | None = None) -> int:
                              "GeoJSON (.geojson); repeatable")  # fmt: skip
     report.add_argument("--csv", metavar="FILE",
                         help="write one row per realization (status, outputs, inputs; columns with units) to this CSV")
+    report.add_argument("--plots", metavar="DIR",
+                        help="write histograms of apogee, impact distance from the pad and landing speed (PNG) "
+                             "to this folder")  # fmt: skip
     report.add_argument("--outside-radius", type=float, metavar="M",
                         help="the probability of landing more than M metres from the pad, with its exact 95 %% "
                              "interval (flights without an impact point counted as outside)")  # fmt: skip

@@ -138,3 +138,28 @@ def test_draws_on_given_axes():
     ellipses = _ellipse_lines(ax)
     assert len(ellipses) == 1 and ellipses[0].get_label().startswith("90 % ellipse")
     assert to_rgb(ellipses[0].get_color()) == to_rgb(COLORS[0])
+
+
+def test_histograms_are_written_and_count_the_flights_shown(tmp_path):
+    """The three PNGs are written; the ok bars count the ok flights with the value, the grey ones the failed
+    flights that landed (the synthetic file's status-2 row), in the same bins, N in the title."""
+    from rocketmc.analysis import load_run
+    from rocketmc.analysis.plots import plot_histograms
+
+    from .test_results import _synthetic, _write
+
+    outputs, inputs = _synthetic()
+    _write(tmp_path / "run.h5", outputs, inputs)
+    figures = plot_histograms(load_run(tmp_path / "run.h5"), tmp_path)
+    assert [p.name for p in figures] == ["apogee.png", "impact_distance.png", "landing_speed.png"]
+    status = outputs["status"]
+    distance = np.hypot(outputs["impact_north_m"], outputs["impact_east_m"])
+    for (path, fig), x, unit in zip(figures.items(), (outputs["apogee_agl_m"], distance, outputs["impact_speed_mps"]),
+                                    ("[m]", "[m]", "[m/s]")):  # fmt: skip
+        assert imread(path).shape[2] in (3, 4)
+        ax = fig.axes[0]
+        ok_bars, failed_bars = ax.containers
+        heights = [np.array([b.get_height() for b in bars]) for bars in (ok_bars, failed_bars)]
+        n_ok, n_failed = int((np.isfinite(x) & (status == 0)).sum()), int((np.isfinite(x) & (status == 2)).sum())
+        assert (heights[0].sum(), heights[1].sum()) == (n_ok, n_failed) and n_failed == 1
+        assert f"N = {n_ok + n_failed} of {len(status)} flights" in ax.get_title() and ax.get_xlabel().endswith(unit)

@@ -79,6 +79,42 @@ def plot_impacts(
     return fig
 
 
+_HISTOGRAMS = (("apogee", "apogee above the pad", "m"), ("impact_distance", "impact distance from the pad", "m"),
+               ("landing_speed", "landing speed", "m/s"))  # fmt: skip
+
+
+def plot_histograms(run: Run, folder: str | Path, bins: int = 30) -> dict[Path, Figure]:
+    """Histograms of apogee [m], impact distance from the pad [m] and landing speed [m/s], written to
+    ``folder`` as ``apogee.png``, ``impact_distance.png`` and ``landing_speed.png``: the ok flights, and
+    stacked on them in grey the failed flights that landed (same bins); N of each in the title and the
+    legend, flights without the value (no impact point, NaN) counted in the title. Returns path -> figure."""
+    out = run.outputs
+    values = {"apogee": out["apogee_agl_m"].to_numpy(float), "landing_speed": out["impact_speed_mps"].to_numpy(float),
+              "impact_distance": np.hypot(out["impact_north_m"].to_numpy(float), out["impact_east_m"].to_numpy(float))}
+    landed_failed = ~run.ok & run.has_impact
+    figures = {}
+    for stem, label, unit in _HISTOGRAMS:
+        x = values[stem]
+        ok, failed = x[run.ok & np.isfinite(x)], x[landed_failed & np.isfinite(x)]
+        fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+        ax = fig.add_subplot()
+        edges = np.histogram_bin_edges(np.concatenate([ok, failed]), bins=bins)
+        ax.hist([ok, failed], bins=edges, stacked=True, color=["tab:blue", "0.55"],
+                label=[f"ok ({ok.size})", f"failed, landed ({failed.size})"])  # fmt: skip
+        title = f"{run.attrs.get('campaign_name', '')}: {label}, N = {ok.size + failed.size} of {len(x)} flights"
+        if ok.size + failed.size < len(x):
+            title += f"\n({len(x) - ok.size - failed.size} without a value: failed in flight or no impact point)"
+        ax.set_title(title)
+        ax.set_xlabel(f"{label} [{unit}]")
+        ax.set_ylabel("flights")
+        ax.grid(True, alpha=0.4)
+        ax.legend(fontsize="small")
+        path = Path(folder) / f"{stem}.png"
+        _save(fig, path)
+        figures[path] = fig
+    return figures
+
+
 def plot_comparison(
     runs: Sequence[tuple[str, Run]],
     path: str | Path | None = None,
