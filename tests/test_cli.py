@@ -233,7 +233,10 @@ def test_report_maps_of_failed_flights(tmp_path, capsys):
     geojson, kml = tmp_path / "m.geojson", tmp_path / "m.kml"
     assert main(["report", str(result), "--map", str(geojson), "--map", str(kml)]) == 0
     failed = [x for x in json.loads(geojson.read_text())["features"] if x["properties"].get("status") == 3]
-    assert len(failed) == 1 and failed[0]["properties"]["count"] == 4 and failed[0]["properties"]["message"] == "tumbled"
+    assert [x["properties"]["index"] for x in failed] == [0, 1, 2, 3]
+    assert {x["properties"]["message"] for x in failed} == {"tumbled"}
+    with h5py.File(result) as f:
+        assert [x["properties"]["apogee_m"] for x in failed] == f["outputs/apogee_agl_m"][:4].tolist()
     assert "status 3 (4 landed): tumbled" in kml.read_text()
 
 
