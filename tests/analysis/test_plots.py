@@ -7,6 +7,7 @@ module and the plot agree with each other.
 """
 
 import numpy as np
+import pytest
 import pandas as pd
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
@@ -163,3 +164,56 @@ def test_histograms_are_written_and_count_the_flights_shown(tmp_path):
         n_ok, n_failed = int((np.isfinite(x) & (status == 0)).sum()), int((np.isfinite(x) & (status == 2)).sum())
         assert (heights[0].sum(), heights[1].sum()) == (n_ok, n_failed) and n_failed == 1
         assert f"N = {n_ok + n_failed} of {len(status)} flights" in ax.get_title() and ax.get_xlabel().endswith(unit)
+
+
+def _with_setup(run, wind, inputs, azimuth_deg=130.0):
+    """``run`` with a ``setup`` attribute holding ``wind`` and the launch azimuth [deg], and ``inputs``."""
+    import json
+
+    setup = {"config": {"launch": {"azimuth_deg": azimuth_deg}, "environment": {"wind": wind}}}
+    return Run(run.outputs, pd.DataFrame(inputs, index=run.outputs.index), {**run.attrs, "setup": json.dumps(setup)},
+               run.units, run.status_codes)  # fmt: skip
+
+
+def test_launch_and_wind_of_fixed_directions_and_the_arrows_drawn():
+    """Two layers from 90° (east), the lower one's speed dispersed: the vector mean blows west at the mean
+    speed; the rail azimuth is the circular mean of the drawn ones (359° and 3°: 1°, not 181°)."""
+    from rocketmc.analysis.plots import launch_and_wind
+
+    run = _run()
+    speed = np.linspace(2.0, 6.0, N)  # mean 4 m/s
+    wind = {"model": "layers", "layers": [{"speed_mps": 0.0, "from_deg": 90.0}, {"speed_mps": 10.0, "from_deg": 90.0}]}
+    run = _with_setup(run, wind, {"environment.wind.layers.0.speed_mps": speed,
+                                  "launch.azimuth_deg": np.where(np.arange(N) % 2, 359.0, 3.0)})  # fmt: skip
+    found = launch_and_wind(run)
+    assert found["azimuth_deg"] == pytest.approx(1.0, abs=1e-9)
+    w = found["wind"]
+    assert w["speed_mps"] == pytest.approx(7.0) and w["east_mps"] == pytest.approx(-7.0) and abs(w["north_mps"]) < 1e-12
+    assert w["from_deg"] == pytest.approx(90.0) and w["resultant"] == pytest.approx(1.0) and not w["spread"]
+    ax = plot_impacts(run).axes[0]
+    arrows = [a for a in ax.texts if getattr(a, "arrow_patch", None) is not None]
+    assert len(arrows) == 2
+    rail, blow = (np.asarray(a.xy) for a in arrows)  # (east, north) of each tip
+    assert np.degrees(np.arctan2(*rail)) == pytest.approx(1.0) and np.degrees(np.arctan2(*blow)) == pytest.approx(-90.0)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "mean wind 7.0 m/s from 90°\n(the arrow: where it blows to)" in legend
+
+
+def test_spread_wind_directions_give_no_wind_arrow():
+    """Directions drawn uniformly over 360° (as lynx_nominal; here a constant wind): the vector mean is near zero, so
+    the figure gives the mean speed, says the direction is spread and draws the rail arrow only; without setup, none."""
+    from rocketmc.analysis.plots import launch_and_wind
+
+    rng = np.random.default_rng(5)
+    wind = {"model": "constant", "speed_mps": 0.0, "from_deg": 0.0}
+    run = _with_setup(_run(), wind, {"environment.wind.speed_mps": rng.uniform(0.0, 8.0, N),
+                                     "environment.wind.from_deg": rng.uniform(0.0, 360.0, N)})  # fmt: skip
+    w = launch_and_wind(run)["wind"]
+    assert w["spread"] and w["resultant"] < 0.15  # ~ 1/sqrt(N) for N = 500
+    speed = run.inputs["environment.wind.speed_mps"].mean()
+    assert w["speed_mps"] == pytest.approx(speed)
+    ax = plot_impacts(run).axes[0]
+    assert len([a for a in ax.texts if getattr(a, "arrow_patch", None) is not None]) == 1  # the rail only
+    assert any(t.get_text().startswith(f"mean wind speed {speed:.1f} m/s, its direction\nspread")
+               for t in ax.get_legend().get_texts())  # fmt: skip
+    assert launch_and_wind(_run()) is None  # a file without setup: nothing drawn

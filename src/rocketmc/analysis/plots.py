@@ -5,6 +5,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+import json
+
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -24,6 +26,82 @@ def _shorten(text: str, width: int = 40) -> str:
     return text if len(text) <= width else text[: width - 1] + "…"
 
 
+SPREAD_RESULTANT = 0.5
+"""Below this ratio of the mean wind vector's length to the mean wind speed the directions are called spread
+(0 for directions drawn uniformly over 360°, 1 for one fixed direction): no wind arrow is drawn then."""
+
+
+def launch_and_wind(run: Run) -> dict | None:
+    """The rail azimuth and the mean wind from the file's ``setup`` attribute (its resolved campaign), each
+    value taken per flight from ``/inputs`` where dispersed; None for a file without ``setup``.
+
+    ``{"azimuth_deg": circular mean rail azimuth [deg clockwise from north], "wind": None (a profile
+    file) or {"speed_mps": mean wind speed [m/s], "north_mps", "east_mps": the vector mean of the wind
+    blowing towards [m/s], "from_deg": the direction the vector mean blows from, "resultant": its length
+    over the mean speed, "spread": resultant < SPREAD_RESULTANT}}``. Over the flights and the wind layers
+    (each layer weighted alike; ``constant`` and ``power_law`` winds at their reference height)."""
+    if "setup" not in run.attrs:
+        return None
+    config = json.loads(run.attrs["setup"])["config"]
+
+    def drawn(name, default):
+        """The values of ``name`` per flight: its /inputs column where dispersed, else ``default``."""
+        return run.inputs[name].to_numpy(float) if name in run.inputs else np.full(len(run.outputs), float(default))
+
+    def resultant(degrees, lengths):
+        """(north, east) of the mean of the vectors of ``lengths`` towards ``degrees`` (clockwise from north)."""
+        radians = np.radians(degrees)
+        return float(np.mean(lengths * np.cos(radians))), float(np.mean(lengths * np.sin(radians)))
+
+    azimuth_north, azimuth_east = resultant(drawn("launch.azimuth_deg", config["launch"]["azimuth_deg"]), 1.0)
+    wind = config["environment"]["wind"]
+    if wind["model"] == "layers":
+        names = [f"environment.wind.layers.{k}." for k in range(len(wind["layers"]))]
+        layers = [(drawn(f"{n}speed_mps", layer["speed_mps"]), drawn(f"{n}from_deg", layer["from_deg"]))
+                  for n, layer in zip(names, wind["layers"])]  # fmt: skip
+    elif wind["model"] == "profile":
+        layers = []
+    else:
+        layers = [(drawn("environment.wind.speed_mps", wind["speed_mps"]),
+                   drawn("environment.wind.from_deg", wind["from_deg"]))]  # fmt: skip
+    result = {"azimuth_deg": float(np.degrees(np.arctan2(azimuth_east, azimuth_north)) % 360.0), "wind": None}
+    if layers:
+        speed, from_deg = (np.concatenate(values) for values in zip(*layers))
+        north, east = resultant(from_deg + 180.0, speed)
+        mean_speed = float(speed.mean())
+        ratio = float(np.hypot(north, east) / mean_speed) if mean_speed > 0 else 0.0
+        result["wind"] = {"speed_mps": mean_speed, "north_mps": north, "east_mps": east, "resultant": ratio,
+                          "from_deg": float(np.degrees(np.arctan2(-east, -north)) % 360.0),
+                          "spread": ratio < SPREAD_RESULTANT}  # fmt: skip
+    return result
+
+
+def _draw_launch_and_wind(ax: Axes, run: Run, length_m: float) -> None:
+    """The rail azimuth and the mean wind (where it blows to) as arrows of ``length_m`` [m] from the pad; the
+    mean wind speed in words when the directions are spread (see :data:`SPREAD_RESULTANT`)."""
+    found = launch_and_wind(run)
+    if found is None:
+        return
+    arrows = [("tab:gray", found["azimuth_deg"], f"rail {found['azimuth_deg']:.0f}°")]
+    wind = found["wind"]
+    if wind is None:
+        note = "wind: from a profile file, not drawn"
+    elif wind["speed_mps"] == 0.0:
+        note = "calm: no wind"
+    elif wind["spread"]:
+        note = (f"mean wind speed {wind['speed_mps']:.1f} m/s, its direction\nspread over the flights (vector mean "
+                f"{wind['resultant'] * wind['speed_mps']:.1f} m/s): no arrow")  # fmt: skip
+    else:
+        note = f"mean wind {wind['speed_mps']:.1f} m/s from {wind['from_deg']:.0f}°\n(the arrow: where it blows to)"
+        arrows.append(("tab:cyan", (wind["from_deg"] + 180.0) % 360.0, f"wind from {wind['from_deg']:.0f}°"))
+    for color, towards_deg, label in arrows:
+        tip = (length_m * np.sin(np.radians(towards_deg)), length_m * np.cos(np.radians(towards_deg)))  # (east, north)
+        ax.annotate("", xy=tip, xytext=(0.0, 0.0), arrowprops={"arrowstyle": "-|>", "color": color, "linewidth": 2.0},
+                    zorder=6)  # fmt: skip
+        ax.annotate(label, xy=tip, xytext=(3, 3), textcoords="offset points", color=color, fontsize="small", zorder=6)
+    ax.plot([], [], color=arrows[-1][0] if len(arrows) > 1 else "none", linewidth=2.0, label=note)  # a legend line
+
+
 def _area_label(area_m2: float) -> str:
     """Area in km^2 (m^2 below 0.01 km^2)."""
     if area_m2 >= 1e4:
@@ -40,7 +118,8 @@ def plot_impacts(
     """Impact points of ok realizations with their confidence ellipses.
 
     East [m] on the x axis, north [m] on the y axis, equal aspect; the pad (origin) and the
-    mean impact point are marked. Failed realizations that landed are drawn apart, one marker per
+    mean impact point are marked, with the rail azimuth and the mean wind from the pad (see
+    :func:`launch_and_wind`). Failed realizations that landed are drawn apart, one marker per
     status, and counted in the legend (those without an impact point only counted in the title);
     ellipses are omitted when fewer than 3 ok impact points exist. Draws on ``ax`` if given
     (else on a new figure, without pyplot) and saves to ``path`` (PNG at 150 dpi) if given.
@@ -60,6 +139,8 @@ def plot_impacts(
                        linewidths=1.0, label=f"status {code} ({int(where.sum())} landed): "
                        f"{_shorten(run.status_codes.get(code, 'unknown'))}", zorder=5)  # fmt: skip
     ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
+    reach = np.hypot(*run.ok_impacts(run.has_impact))
+    _draw_launch_and_wind(ax, run, 0.4 * float(reach.max()) if reach.size else 100.0)
     if north.size >= 3:
         for i, level in enumerate(levels):
             ellipse = confidence_ellipse(north, east, level)
