@@ -252,3 +252,23 @@ def test_report_plots(small_run, tmp_path, capsys):
     assert "--plots" in err and len(err.splitlines()) == 1
     assert main(["report", str(small_run), "--plots", str(tmp_path / "no" / "such")]) == 2
     assert not (tmp_path / "no").exists()
+
+
+def test_report_outside_polygon(small_run, tmp_path, capsys):
+    """A square of ±0.5° around the pad holds every flight; a malformed file: one line naming it, exit 2, no output."""
+    import tomllib
+
+    with h5py.File(small_run) as f:
+        site = tomllib.loads(f.attrs["campaign_toml"])["site"]
+    lat, lon = site["latitude_deg"], site["longitude_deg"]
+    ring = [[lon - 0.5, lat - 0.5], [lon + 0.5, lat - 0.5], [lon + 0.5, lat + 0.5], [lon - 0.5, lat + 0.5], [lon - 0.5, lat - 0.5]]
+    area = tmp_path / "range.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [ring]}))
+    assert main(["report", str(small_run), "--json", "--outside-polygon", str(area)]) == 0
+    result = json.loads(capsys.readouterr().out)["outside_polygon"]
+    assert result["outside"] == 0 and result["n"] == 6 and result["polygon"] == "range.geojson"
+    bad, csv = tmp_path / "bad.csv", tmp_path / "out.csv"
+    bad.write_text("lat_deg,longitude\n41,14\n")
+    assert main(["report", str(small_run), "--outside-polygon", str(bad), "--csv", str(csv)]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.splitlines()) == 1 and str(bad) in err and "lon_deg" in err and not csv.exists()

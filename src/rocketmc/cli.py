@@ -121,13 +121,19 @@ def _report(args) -> int:
         raise RocketmcError(f"--plots {plots}: expected a folder, or a new one's name in an existing folder")
     run = load_run(args.file)
     summary = summarize(run)
-    if args.outside_radius is not None:
-        from .analysis.safety import format_outside, outside_radius
+    from .analysis.safety import format_outside, outside_polygon, outside_radius, read_polygon
 
+    if args.outside_radius is not None:
         summary["outside_radius"] = outside_radius(run, args.outside_radius)
+    if args.outside_polygon is not None:
+        from .analysis.export import site_of
+
+        rings = read_polygon(args.outside_polygon, *site_of(run)[1:])
+        summary["outside_polygon"] = outside_polygon(run, rings, Path(args.outside_polygon).name)
     text = format_summary(summary)
-    if "outside_radius" in summary:
-        text += "\n\n" + format_outside(summary["outside_radius"])
+    for key in ("outside_radius", "outside_polygon"):
+        if key in summary:
+            text += "\n\n" + format_outside(summary[key])
     print(json.dumps(summary, indent=2, allow_nan=False) if args.json else text)
     if plot:
         plot_impacts(run, path=plot)
@@ -485,6 +491,9 @@ def main(argv: list[str] | None = None) -> int:
     report.add_argument("--outside-radius", type=float, metavar="M",
                         help="the probability of landing more than M metres from the pad, with its exact 95 %% "
                              "interval (flights without an impact point counted as outside)")  # fmt: skip
+    report.add_argument("--outside-polygon", metavar="FILE",
+                        help="the probability of landing outside the range's allowed area, a GeoJSON Polygon or a "
+                             "CSV of lat_deg,lon_deg vertices; counted as --outside-radius")  # fmt: skip
     compare = commands.add_parser("compare", help="compare the landing dispersion of result files with the first's")
     compare.add_argument("files", nargs="+", metavar="FILE",
                          help="HDF5 result files, at least two; the first is the baseline")  # fmt: skip

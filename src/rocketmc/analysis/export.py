@@ -13,7 +13,7 @@ import numpy as np
 from ..env.site import latitude_longitude_deg
 from ..files import replacing
 from .ellipse import confidence_ellipse
-from .results import SUMMARY_LEVELS, Run
+from .results import SUMMARY_LEVELS, ResultFileError, Run
 
 KML_NAMESPACE = "http://www.opengis.net/kml/2.2"
 MAP_SUFFIXES = (".kml", ".geojson", ".json")
@@ -23,13 +23,13 @@ _MARKER_COLORS = {"ok": "#1f77b4", "failed": "#000000"}  # impact points by stat
 _KML_MARKER_COLORS = {"ok": "ffb4771f", "failed": "ff000000"}  # the same in aabbggrr
 
 
-def _site(run: Run) -> tuple[str, float, float]:
+def site_of(run: Run) -> tuple[str, float, float]:
     """(name, latitude [deg], longitude [deg]) of the run's launch site, from its campaign text."""
     try:
         site = tomllib.loads(run.attrs["campaign_toml"])["site"]
         return site.get("name", ""), float(site["latitude_deg"]), float(site["longitude_deg"])
     except (KeyError, tomllib.TOMLDecodeError, TypeError, ValueError):
-        raise ValueError("the result file's campaign_toml attribute has no [site] latitude_deg/longitude_deg") from None
+        raise ResultFileError("the result file's campaign_toml attribute has no [site] latitude_deg/longitude_deg") from None
 
 
 def map_features(run: Run, levels=SUMMARY_LEVELS) -> dict:
@@ -39,7 +39,7 @@ def map_features(run: Run, levels=SUMMARY_LEVELS) -> dict:
     ``{"index": realization, "status": code, "message": its text, "apogee_m": apogee above the pad [m] or None,
     "position": (lon, lat)}``. Ellipses from the ok points only; each ring closed (last point = first) and
     counterclockwise seen from above."""
-    name, lat0, lon0 = _site(run)
+    name, lat0, lon0 = site_of(run)
     north, east = run.ok_impacts()
     ellipses = {}
     if north.size >= 3:
