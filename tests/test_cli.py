@@ -253,3 +253,103 @@ def test_fly_bad_input_exit_2(tmp_path, capsys):
     assert "--realization 1000" in lines[0] and "(0 to 999)" in lines[0]
     assert "--out" in lines[1] and ".csv or .h5" in lines[1] and "--kml" in lines[2]
     assert not list(tmp_path.iterdir())
+
+
+def test_report_of_an_unstable_rocket(tmp_path, capsys):
+    """Acceptance (issue 19): campaigns/unstable_rocket.toml (no fins) tumbles; report shows its impacts,
+    counts and statuses: every flight failed with status 3, each with an impact point, drawn apart; run warned
+    of the negative static margin before flying (even with --quiet) and the report repeats it from the file."""
+    out, png = tmp_path / "unstable.h5", tmp_path / "unstable.png"
+    assert main(["run", str(CAMPAIGNS / "unstable_rocket.toml"), "-n", "8", "--out", str(out), "--quiet"]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if line.startswith("rocketmc: warning:")]
+    assert any("statically unstable at liftoff" in line for line in warned), warned
+    assert main(["report", str(out), "--json", "--plot", str(png)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert any("statically unstable at liftoff" in line for line in summary["warnings"]), summary["warnings"]
+    assert summary["n_ok"] == 0 and summary["impact_ellipses"] == []
+    assert summary["failed"] == [{"code": 3, "message": summary["failed"][0]["message"], "count": 8, "landed": 8,
+                                  "no_impact_point": 0}]  # fmt: skip
+    assert png.stat().st_size > 10_000
+    assert main(["report", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "Failed realizations" in text and "Realizations: 8 total, 0 ok" in text
+    assert "Warning: unstable_rocket: the nominal rocket is statically unstable at liftoff" in text
+
+
+def test_report_outside_radius(small_run, capsys):
+    assert main(["report", str(small_run), "--json", "--outside-radius", "1e7"]) == 0
+    result = json.loads(capsys.readouterr().out)["outside_radius"]
+    assert result["outside"] == 0 and result["n"] == 6 and result["upper_bound_none_outside"] > 0.39
+    with pytest.raises(SystemExit) as info:
+        main(["report", str(small_run), "--outside-radius", "-5"])
+    assert info.value.code == 2 and "--outside-radius" in capsys.readouterr().err
+
+
+def test_report_csv(small_run, tmp_path, capsys):
+    """One row per realization, status first, columns with units; values as in the result file."""
+    import pandas as pd
+
+    csv = tmp_path / "run.csv"
+    assert main(["report", str(small_run), "--csv", str(csv)]) == 0
+    table = pd.read_csv(csv, index_col="realization")
+    with h5py.File(small_run) as f:
+        assert list(table["status"]) == list(f["outputs/status"][:])
+        np.testing.assert_array_equal(table["impact_north_m [m]"], f["outputs/impact_north_m"][:])  # repr round-trips
+        np.testing.assert_array_equal(table["input: launch.azimuth_deg"], f["inputs/launch.azimuth_deg"][:])
+    assert len(table) == 6
+    capsys.readouterr()
+    assert main(["report", str(small_run), "--csv", str(tmp_path / "run.txt")]) == 2
+    assert "--csv" in capsys.readouterr().err and not (tmp_path / "run.txt").exists()
+
+
+def test_report_maps_of_failed_flights(tmp_path, capsys):
+    """The failed flights that landed are on the maps apart, with their status (a crafted file: no flight)."""
+    from .test_cli_errors import write_result
+
+    status = np.zeros(50, np.int32)
+    status[:4] = 3
+    result = write_result(tmp_path / "run.h5", status=status)
+    with h5py.File(result, "r+") as f:
+        f["outputs/status"].attrs["codes"] = json.dumps({"0": "ok", "3": "tumbled"})
+    geojson, kml = tmp_path / "m.geojson", tmp_path / "m.kml"
+    assert main(["report", str(result), "--map", str(geojson), "--map", str(kml)]) == 0
+    failed = [x for x in json.loads(geojson.read_text())["features"] if x["properties"].get("status") == 3]
+    assert [x["properties"]["index"] for x in failed] == [0, 1, 2, 3]
+    assert {x["properties"]["message"] for x in failed} == {"tumbled"}
+    with h5py.File(result) as f:
+        assert [x["properties"]["apogee_m"] for x in failed] == f["outputs/apogee_agl_m"][:4].tolist()
+    assert "status 3 (4 landed): tumbled" in kml.read_text()
+
+
+def test_report_plots(small_run, tmp_path, capsys):
+    """--plot-dir DIR makes the folder and writes the three histograms; a file in its place: one line, exit 2."""
+    folder = tmp_path / "histograms"
+    assert main(["report", str(small_run), "--plot-dir", str(folder)]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == ["apogee.png", "impact_distance.png", "landing_speed.png"]
+    capsys.readouterr()
+    (tmp_path / "taken").write_text("")
+    assert main(["report", str(small_run), "--plot-dir", str(tmp_path / "taken")]) == 2
+    err = capsys.readouterr().err
+    assert "--plot-dir" in err and len(err.splitlines()) == 1
+    assert main(["report", str(small_run), "--plot-dir", str(tmp_path / "no" / "such")]) == 2
+    assert not (tmp_path / "no").exists()
+
+
+def test_report_outside_polygon(small_run, tmp_path, capsys):
+    """A square of ±0.5° around the pad holds every flight; a malformed file: one line naming it, exit 2, no output."""
+    import tomllib
+
+    with h5py.File(small_run) as f:
+        site = tomllib.loads(f.attrs["campaign_toml"])["site"]
+    lat, lon = site["latitude_deg"], site["longitude_deg"]
+    ring = [[lon - 0.5, lat - 0.5], [lon + 0.5, lat - 0.5], [lon + 0.5, lat + 0.5], [lon - 0.5, lat + 0.5], [lon - 0.5, lat - 0.5]]
+    area = tmp_path / "range.geojson"
+    area.write_text(json.dumps({"type": "Polygon", "coordinates": [ring]}))
+    assert main(["report", str(small_run), "--json", "--outside-polygon", str(area)]) == 0
+    result = json.loads(capsys.readouterr().out)["outside_polygon"]
+    assert result["outside"] == 0 and result["n"] == 6 and result["polygon"] == "range.geojson"
+    bad, csv = tmp_path / "bad.csv", tmp_path / "out.csv"
+    bad.write_text("lat_deg,longitude\n41,14\n")
+    assert main(["report", str(small_run), "--outside-polygon", str(bad), "--csv", str(csv)]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.splitlines()) == 1 and str(bad) in err and "lon_deg" in err and not csv.exists()

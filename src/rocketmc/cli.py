@@ -134,14 +134,41 @@ def _report(args) -> int:
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     maps = [_refuse_existing("--map", _output_file("--map", path, MAP_SUFFIXES), args.force) for path in args.map or []]
+    csv = None if args.csv is None else _refuse_existing("--csv", _output_file("--csv", args.csv, (".csv",)), args.force)
+    plots = None if args.plot_dir is None else Path(args.plot_dir)
+    if plots is not None and (plots.exists() and not plots.is_dir() or not plots.parent.is_dir()):
+        raise RocketmcError(f"--plot-dir {plots}: expected a folder, or a new one's name in an existing folder")
     run = load_run(args.file)
     summary = summarize(run)
-    print(json.dumps(summary, indent=2, allow_nan=False) if args.json else format_summary(summary))
+    from .analysis.safety import format_outside, outside_polygon, outside_radius, read_polygon
+
+    if args.outside_radius is not None:
+        summary["outside_radius"] = outside_radius(run, args.outside_radius)
+    if args.outside_polygon is not None:
+        from .analysis.export import site_of
+
+        rings = read_polygon(args.outside_polygon, *site_of(run)[1:])
+        summary["outside_polygon"] = outside_polygon(run, rings, Path(args.outside_polygon).name)
+    text = format_summary(summary)
+    for key in ("outside_radius", "outside_polygon"):
+        if key in summary:
+            text += "\n\n" + format_outside(summary[key])
+    print(json.dumps(summary, indent=2, allow_nan=False) if args.json else text)
     if plot:
         plot_impacts(run, path=plot)
         print(f"wrote {plot}", file=sys.stderr)
     for path in maps:
         print(f"wrote {write_map(run, path)}", file=sys.stderr)
+    if csv:
+        from .analysis.export import write_csv
+
+        print(f"wrote {write_csv(run, csv)}", file=sys.stderr)
+    if plots is not None:
+        from .analysis.plots import plot_histograms
+
+        plots.mkdir(exist_ok=True)
+        for path in plot_histograms(run, plots):
+            print(f"wrote {path}", file=sys.stderr)
     return 0
 
 
@@ -527,10 +554,21 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("file", help="HDF5 result file")
     report.add_argument("--plot", help="write the impact plot with 50/95/99 %% ellipses to this PNG")
     report.add_argument("--json", action="store_true", help="print the summary as JSON")
-    report.add_argument("--force", action="store_true", help="replace existing --map files")
+    report.add_argument("--force", action="store_true", help="replace existing --map and --csv files")
     report.add_argument("--map", action="append", metavar="FILE",
                         help="write the impact points and ellipses around the launch site as KML (.kml) or "
                              "GeoJSON (.geojson); repeatable")  # fmt: skip
+    report.add_argument("--csv", metavar="FILE",
+                        help="write one row per realization (status, outputs, inputs; columns with units) to this CSV")
+    report.add_argument("--plot-dir", metavar="DIR",
+                        help="write histograms of apogee, impact distance from the pad and landing speed (PNG) "
+                             "to this folder")  # fmt: skip
+    report.add_argument("--outside-radius", type=float, metavar="M",
+                        help="the probability of landing more than M metres from the pad, with its exact 95 %% "
+                             "interval (flights without an impact point counted as outside)")  # fmt: skip
+    report.add_argument("--outside-polygon", metavar="FILE",
+                        help="the probability of landing outside the range's allowed area, a GeoJSON Polygon or a "
+                             "CSV of lat_deg,lon_deg vertices; counted as --outside-radius")  # fmt: skip
     compare = commands.add_parser("compare", help="compare the landing dispersion of result files with the first's")
     compare.add_argument("files", nargs="+", metavar="FILE",
                          help="HDF5 result files, at least two; the first is the baseline")  # fmt: skip
@@ -636,6 +674,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("-n/--n must be at least 1")
     if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
         parser.error("--until-converged must be a percentage in (0, 100]")
+    if getattr(args, "outside_radius", None) is not None and not 0 < args.outside_radius < float("inf"):
+        parser.error("--outside-radius must be a positive distance in metres")
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
     for name in ("n", "chunk_size", "workers") if args.command != "bench" else ("chunk_size",):

@@ -24,9 +24,11 @@ def run():
     east += 0.4 * north  # a tilted footprint
     status = np.zeros(500, dtype=np.int32)
     status[:7] = 2
-    outputs = pd.DataFrame({"impact_north_m": north, "impact_east_m": east, "status": status})
+    apogee = rng.normal(3000.0, 80.0, 500)
+    apogee[8] = np.nan  # an ok flight without an apogee: null on the map
+    outputs = pd.DataFrame({"impact_north_m": north, "impact_east_m": east, "status": status, "apogee_agl_m": apogee})
     toml = f'name = "map"\n[site]\nname = "Roccaraso"\nlatitude_deg = {SITE[0]}\nlongitude_deg = {SITE[1]}\naltitude_m = 1416.0\n'
-    return Run(outputs, pd.DataFrame(), {"campaign_name": "map", "campaign_toml": toml}, {}, {})
+    return Run(outputs, pd.DataFrame(), {"campaign_name": "map", "campaign_toml": toml}, {}, {0: "ok", 2: "tumbled"})
 
 
 def test_local_plane_round_trip_and_against_the_sphere():
@@ -44,11 +46,10 @@ def test_geojson_is_valid_and_ellipses_lie_on_the_ellipse(run):
     data = json.loads(json.dumps(to_geojson(run)))  # plain JSON types only
     assert data["type"] == "FeatureCollection"
     kinds = [f["geometry"]["type"] for f in data["features"]]
-    assert kinds == ["Point", "MultiPoint", "Polygon", "Polygon", "Polygon"]
+    assert kinds == ["Point", "Polygon", "Polygon", "Polygon"] + ["Point"] * 500  # a Point per flight, failed last
     assert data["features"][0]["geometry"]["coordinates"] == [SITE[1], SITE[0]]  # [longitude, latitude]
-    assert len(data["features"][1]["geometry"]["coordinates"]) == 493  # the ok impacts
     north, east = run.ok_impacts()
-    for feature in data["features"][2:]:
+    for feature in data["features"][1:4]:
         assert feature["type"] == "Feature" and "properties" in feature
         (ring,) = feature["geometry"]["coordinates"]
         assert len(ring) >= 4 and ring[0] == ring[-1]  # RFC 7946 §3.1.6: closed linear ring
@@ -64,6 +65,50 @@ def test_geojson_is_valid_and_ellipses_lie_on_the_ellipse(run):
         np.testing.assert_allclose(radius2, 1.0, atol=1e-9)
 
 
+def _expected_position(run, index):
+    """(longitude, latitude) [deg] of realization ``index``'s impact point."""
+    lat, lon = latitude_longitude_deg(run.outputs["impact_north_m"][index], run.outputs["impact_east_m"][index], *SITE)
+    return [float(lon), float(lat)]
+
+
+def test_geojson_points_carry_their_flight(run, tmp_path):
+    """Read back from the written file: one Point per flight that landed, with its realization's index,
+    status and apogee [m] (null where NaN), where that realization landed, coloured by status."""
+    data = json.loads(write_map(run, tmp_path / "m.geojson").read_text())
+    points = data["features"][4:]
+    assert sorted(p["properties"]["index"] for p in points) == list(range(500))
+    apogee = run.outputs["apogee_agl_m"]
+    for p in points:
+        i, props = p["properties"]["index"], p["properties"]
+        assert props["status"] == run.outputs["status"][i] and props["name"] == f"impact {i}"
+        assert props["apogee_m"] == (None if i == 8 else apogee[i])  # exact: JSON keeps the float's repr
+        assert props["message"] == ("ok" if i >= 7 else "tumbled")
+        assert props["marker-color"] == ("#1f77b4" if i >= 7 else "#000000")
+        np.testing.assert_allclose(p["geometry"]["coordinates"], _expected_position(run, i), rtol=0, atol=1e-12)
+
+
+def test_kml_placemarks_carry_their_flight(run, tmp_path):
+    """Read back from the written KML: each impact placemark is named by its realization, described with its
+    status and apogee, its index/status/apogee_m in ExtendedData, styled #ok or #failed."""
+    ns = {"k": KML_NAMESPACE}
+    document = ElementTree.parse(write_map(run, tmp_path / "m.kml")).getroot().find("k:Document", ns)
+    assert {s.get("id") for s in document.findall("k:Style", ns)} >= {"ok", "failed"}
+    marks = document.findall("k:Folder/k:Placemark", ns)
+    assert len(marks) == 500
+    for mark in marks:
+        data = {d.get("name"): d.findtext("k:value", namespaces=ns) for d in mark.findall("k:ExtendedData/k:Data", ns)}
+        i = int(data["index"])
+        status = int(run.outputs["status"][i])
+        assert int(data["status"]) == status and mark.findtext("k:name", namespaces=ns) == f"impact {i}"
+        assert data["apogee_m"] == ("" if i == 8 else str(run.outputs["apogee_agl_m"][i]))
+        assert mark.findtext("k:styleUrl", namespaces=ns) == ("#ok" if status == 0 else "#failed")
+        description = mark.findtext("k:description", namespaces=ns)
+        assert description.startswith(f"realization {i}, status {status} ({'ok' if status == 0 else 'tumbled'})")
+        assert ("no apogee" if i == 8 else f"apogee {run.outputs['apogee_agl_m'][i]:.0f} m") in description
+        lon, lat, _ = map(float, mark.findtext("k:Point/k:coordinates", namespaces=ns).split(","))
+        np.testing.assert_allclose([lon, lat], _expected_position(run, i), rtol=0, atol=1e-7)  # 7 decimals written
+
+
 def test_kml_parses_and_follows_the_schema_order(run):
     root = ElementTree.fromstring(to_kml(run).encode())
     ns = {"k": KML_NAMESPACE}
@@ -76,7 +121,8 @@ def test_kml_parses_and_follows_the_schema_order(run):
     for ring in rings:
         points = [tuple(map(float, p.split(","))) for p in ring.text.split()]
         assert points[0] == points[-1] and all(len(p) == 3 for p in points)
-    assert len(document.findall("k:Folder/k:Placemark/k:Point", ns)) == 493
+    assert len(document.findall("k:Folder/k:Placemark/k:Point", ns)) == 500  # 493 ok impacts, the failed landed apart
+    assert len(document.findall("k:Folder", ns)[0].findall("k:Placemark", ns)) == 493
     for mark in document.iter(f"{{{KML_NAMESPACE}}}Placemark"):
         children = [c.tag.split("}")[1] for c in mark]
         assert children[0] == "name" and children[-1] in ("Point", "Polygon")  # styleUrl before the geometry

@@ -7,6 +7,7 @@ module and the plot agree with each other.
 """
 
 import numpy as np
+import pytest
 import pandas as pd
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
@@ -49,11 +50,13 @@ def _ellipse_lines(ax):
 def test_title_labels_and_points():
     run = _run()
     ax = plot_impacts(run).axes[0]
-    title = f"plot-test: impact points, {N - N_FAILED} ok / {N}\n({N_FAILED} failed realizations not shown)"
+    title = (f"plot-test: impact points, {N - N_FAILED} ok / {N}, seed 1\n{N_FAILED} failed (not in the ellipses), "
+             f"{min(5, N_FAILED)} of them without an impact point")  # fmt: skip
     assert ax.get_title() == title
     assert ax.get_xlabel() == "east of pad [m]" and ax.get_ylabel() == "north of pad [m]"
     north, east = _ok_points(run)
-    (scatter,) = ax.collections
+    scatter, failed = ax.collections  # the failed flights that landed drawn apart
+    assert np.asarray(failed.get_offsets()).shape == (N_FAILED - 5, 2) and "status 1" in failed.get_label()
     offsets = np.asarray(scatter.get_offsets())
     assert offsets.shape == (N - N_FAILED, 2)  # every ok point once, no failed one
     np.testing.assert_array_equal(offsets, np.column_stack([east, north]))  # east on x, north on y
@@ -63,7 +66,8 @@ def test_title_labels_and_points():
     np.testing.assert_allclose([mean.get_xdata()[0], mean.get_ydata()[0]], [east.mean(), north.mean()], rtol=1e-12)
     assert ax.get_aspect() == 1.0  # equal aspect: the ellipses are not distorted
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert legend[:2] == ["impacts", "pad"] and legend[-1] == "mean impact"
+    assert legend[0] == f"ok impacts ({N - N_FAILED})" and legend[1].startswith("status 1 (2 landed)")
+    assert legend[2] == "pad" and legend[-1] == "mean impact"
 
 
 def test_ellipses_have_the_sample_centre_and_semi_axes():
@@ -87,7 +91,9 @@ def test_ellipses_have_the_sample_centre_and_semi_axes():
         np.testing.assert_allclose(xy.max(axis=0), half_widths, rtol=2e-4)
         np.testing.assert_allclose(-xy.min(axis=0), half_widths, rtol=2e-4)
         area_km2 = np.pi * k2 * np.sqrt(np.linalg.det(sigma)) / 1e6
-        assert line.get_label() == f"{100 * level:g} % ellipse ({area_km2:.3g} km²)"
+        inside = np.mean(np.einsum("ni,ij,nj->n", np.column_stack(_ok_points(run)[::-1]) - mu, np.linalg.inv(sigma),
+                                   np.column_stack(_ok_points(run)[::-1]) - mu) <= k2)  # fmt: skip
+        assert line.get_label() == f"{100 * level:g} % ellipse, {100 * inside:.1f} % inside ({area_km2:.3g} km²)"
         assert to_rgb(line.get_color()) == to_rgb(color)
 
 
@@ -95,10 +101,10 @@ def test_all_ok_and_too_few_points():
     """No failure line in the title when every flight is ok; with fewer than 3 ok points no ellipse
     and no mean marker (a covariance needs 3), the points still drawn."""
     ax = plot_impacts(_run(n_failed=0)).axes[0]
-    assert ax.get_title() == f"plot-test: impact points, {N} ok / {N}"
+    assert ax.get_title() == f"plot-test: impact points, {N} ok / {N}, seed 1"
     assert len(_ellipse_lines(ax)) == 3
     ax = plot_impacts(_run(n=10, n_failed=8)).axes[0]
-    assert ax.get_title().startswith("plot-test: impact points, 2 ok / 10\n(8 failed")
+    assert ax.get_title().startswith("plot-test: impact points, 2 ok / 10, seed 1\n8 failed")
     assert np.asarray(ax.collections[0].get_offsets()).shape == (2, 2)
     assert _ellipse_lines(ax) == [] and "mean impact" not in [line.get_label() for line in ax.lines]
 
@@ -133,3 +139,81 @@ def test_draws_on_given_axes():
     ellipses = _ellipse_lines(ax)
     assert len(ellipses) == 1 and ellipses[0].get_label().startswith("90 % ellipse")
     assert to_rgb(ellipses[0].get_color()) == to_rgb(COLORS[0])
+
+
+def test_histograms_are_written_and_count_the_flights_shown(tmp_path):
+    """The three PNGs are written; the ok bars count the ok flights with the value, the grey ones the failed
+    flights that landed (the synthetic file's status-2 row), in the same bins, N in the title."""
+    from rocketmc.analysis import load_run
+    from rocketmc.analysis.plots import plot_histograms
+
+    from .test_results import _synthetic, _write
+
+    outputs, inputs = _synthetic()
+    _write(tmp_path / "run.h5", outputs, inputs)
+    figures = plot_histograms(load_run(tmp_path / "run.h5"), tmp_path)
+    assert [p.name for p in figures] == ["apogee.png", "impact_distance.png", "landing_speed.png"]
+    status = outputs["status"]
+    distance = np.hypot(outputs["impact_north_m"], outputs["impact_east_m"])
+    for (path, fig), x, unit in zip(figures.items(), (outputs["apogee_agl_m"], distance, outputs["impact_speed_mps"]),
+                                    ("[m]", "[m]", "[m/s]")):  # fmt: skip
+        assert imread(path).shape[2] in (3, 4)
+        ax = fig.axes[0]
+        ok_bars, failed_bars = ax.containers
+        heights = [np.array([b.get_height() for b in bars]) for bars in (ok_bars, failed_bars)]
+        n_ok, n_failed = int((np.isfinite(x) & (status == 0)).sum()), int((np.isfinite(x) & (status == 2)).sum())
+        assert (heights[0].sum(), heights[1].sum()) == (n_ok, n_failed) and n_failed == 1
+        assert f"N = {n_ok + n_failed} of {len(status)} flights" in ax.get_title() and ax.get_xlabel().endswith(unit)
+
+
+def _with_setup(run, wind, inputs, azimuth_deg=130.0):
+    """``run`` with a ``setup`` attribute holding ``wind`` and the launch azimuth [deg], and ``inputs``."""
+    import json
+
+    setup = {"config": {"launch": {"azimuth_deg": azimuth_deg}, "environment": {"wind": wind}}}
+    return Run(run.outputs, pd.DataFrame(inputs, index=run.outputs.index), {**run.attrs, "setup": json.dumps(setup)},
+               run.units, run.status_codes)  # fmt: skip
+
+
+def test_launch_and_wind_of_fixed_directions_and_the_arrows_drawn():
+    """Two layers from 90° (east), the lower one's speed dispersed: the vector mean blows west at the mean
+    speed; the rail azimuth is the circular mean of the drawn ones (359° and 3°: 1°, not 181°)."""
+    from rocketmc.analysis.plots import launch_and_wind
+
+    run = _run()
+    speed = np.linspace(2.0, 6.0, N)  # mean 4 m/s
+    wind = {"model": "layers", "layers": [{"speed_mps": 0.0, "from_deg": 90.0}, {"speed_mps": 10.0, "from_deg": 90.0}]}
+    run = _with_setup(run, wind, {"environment.wind.layers.0.speed_mps": speed,
+                                  "launch.azimuth_deg": np.where(np.arange(N) % 2, 359.0, 3.0)})  # fmt: skip
+    found = launch_and_wind(run)
+    assert found["azimuth_deg"] == pytest.approx(1.0, abs=1e-9)
+    w = found["wind"]
+    assert w["speed_mps"] == pytest.approx(7.0) and w["east_mps"] == pytest.approx(-7.0) and abs(w["north_mps"]) < 1e-12
+    assert w["from_deg"] == pytest.approx(90.0) and w["resultant"] == pytest.approx(1.0) and not w["spread"]
+    ax = plot_impacts(run).axes[0]
+    arrows = [a for a in ax.texts if getattr(a, "arrow_patch", None) is not None]
+    assert len(arrows) == 2
+    rail, blow = (np.asarray(a.xy) for a in arrows)  # (east, north) of each tip
+    assert np.degrees(np.arctan2(*rail)) == pytest.approx(1.0) and np.degrees(np.arctan2(*blow)) == pytest.approx(-90.0)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "mean wind 7.0 m/s from 90°\n(the arrow: where it blows to)" in legend
+
+
+def test_spread_wind_directions_give_no_wind_arrow():
+    """Directions drawn uniformly over 360° (as lynx_nominal; here a constant wind): the vector mean is near zero, so
+    the figure gives the mean speed, says the direction is spread and draws the rail arrow only; without setup, none."""
+    from rocketmc.analysis.plots import launch_and_wind
+
+    rng = np.random.default_rng(5)
+    wind = {"model": "constant", "speed_mps": 0.0, "from_deg": 0.0}
+    run = _with_setup(_run(), wind, {"environment.wind.speed_mps": rng.uniform(0.0, 8.0, N),
+                                     "environment.wind.from_deg": rng.uniform(0.0, 360.0, N)})  # fmt: skip
+    w = launch_and_wind(run)["wind"]
+    assert w["spread"] and w["resultant"] < 0.15  # ~ 1/sqrt(N) for N = 500
+    speed = run.inputs["environment.wind.speed_mps"].mean()
+    assert w["speed_mps"] == pytest.approx(speed)
+    ax = plot_impacts(run).axes[0]
+    assert len([a for a in ax.texts if getattr(a, "arrow_patch", None) is not None]) == 1  # the rail only
+    assert any(t.get_text().startswith(f"mean wind speed {speed:.1f} m/s, its direction\nspread")
+               for t in ax.get_legend().get_texts())  # fmt: skip
+    assert launch_and_wind(_run()) is None  # a file without setup: nothing drawn

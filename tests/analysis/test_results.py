@@ -223,3 +223,34 @@ def test_summary_without_enough_ok_impacts(tmp_path):
     s = summarize(load_run(path))
     assert s["impact_ellipses"] == []
     assert "not available" in format_summary(s)
+
+
+def test_failed_realizations_are_counted_apart(tmp_path):
+    """Failed flights are out of the ellipses but counted per status: the status-1 rows of the synthetic
+    file have NaN impacts (no impact point), the status-2 row kept its impact point (it landed)."""
+    outputs, inputs = _synthetic()
+    path = tmp_path / "run.h5"
+    _write(path, outputs, inputs)
+    summary = summarize(load_run(path))
+    failed = {s["code"]: s for s in summary["failed"]}
+    assert set(failed) == {1, 2}
+    assert (failed[1]["count"], failed[1]["landed"], failed[1]["no_impact_point"]) == (3, 0, 3)
+    assert (failed[2]["count"], failed[2]["landed"], failed[2]["no_impact_point"]) == (1, 1, 0)
+    assert summary["impact_ellipses"][0]["n"] == N - 4
+    assert "Failed realizations" in format_summary(summary)
+
+
+def test_ellipse_coverage_is_the_mahalanobis_fraction(tmp_path):
+    """Each ellipse's ``coverage``: the fraction of ok points with Mahalanobis d² ≤ chi2.ppf(level, 2) under
+    the sample mean and covariance (closed form, independent of Ellipse.contains)."""
+    from scipy.stats import chi2
+
+    outputs, inputs = _synthetic()
+    path = tmp_path / "run.h5"
+    _write(path, outputs, inputs)
+    run = load_run(path)
+    points = np.stack(run.ok_impacts())
+    d = points - points.mean(axis=1, keepdims=True)
+    d2 = np.einsum("in,ij,jn->n", d, np.linalg.inv(np.cov(points)), d)
+    for e in summarize(run)["impact_ellipses"]:
+        assert e["coverage"] == pytest.approx(np.mean(d2 <= chi2.ppf(e["level"], 2)), abs=1.5 / points.shape[1])  # a point on the boundary may round either way

@@ -5,6 +5,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+import json
+
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -14,8 +16,90 @@ from .ellipse import Ellipse, confidence_ellipse
 from .results import Run
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")
+_FAILED_MARKERS = ("x", "+", "1", "s", "D")
 _RUN_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
                "tab:olive", "tab:cyan")  # fmt: skip
+
+
+def _shorten(text: str, width: int = 40) -> str:
+    """``text`` cut to ``width`` characters with an ellipsis (a legend entry on one line)."""
+    return text if len(text) <= width else text[: width - 1] + "…"
+
+
+SPREAD_RESULTANT = 0.5
+"""Below this ratio of the mean wind vector's length to the mean wind speed the directions are called spread
+(0 for directions drawn uniformly over 360°, 1 for one fixed direction): no wind arrow is drawn then."""
+
+
+def launch_and_wind(run: Run) -> dict | None:
+    """The rail azimuth and the mean wind from the file's ``setup`` attribute (its resolved campaign), each
+    value taken per flight from ``/inputs`` where dispersed; None for a file without ``setup``.
+
+    ``{"azimuth_deg": circular mean rail azimuth [deg clockwise from north], "wind": None (a profile
+    file) or {"speed_mps": mean wind speed [m/s], "north_mps", "east_mps": the vector mean of the wind
+    blowing towards [m/s], "from_deg": the direction the vector mean blows from, "resultant": its length
+    over the mean speed, "spread": resultant < SPREAD_RESULTANT}}``. Over the flights and the wind layers
+    (each layer weighted alike; ``constant`` and ``power_law`` winds at their reference height)."""
+    if "setup" not in run.attrs:
+        return None
+    config = json.loads(run.attrs["setup"])["config"]
+
+    def drawn(name, default):
+        """The values of ``name`` per flight: its /inputs column where dispersed, else ``default``."""
+        return run.inputs[name].to_numpy(float) if name in run.inputs else np.full(len(run.outputs), float(default))
+
+    def resultant(degrees, lengths):
+        """(north, east) of the mean of the vectors of ``lengths`` towards ``degrees`` (clockwise from north)."""
+        radians = np.radians(degrees)
+        return float(np.mean(lengths * np.cos(radians))), float(np.mean(lengths * np.sin(radians)))
+
+    azimuth_north, azimuth_east = resultant(drawn("launch.azimuth_deg", config["launch"]["azimuth_deg"]), 1.0)
+    wind = config["environment"]["wind"]
+    if wind["model"] == "layers":
+        names = [f"environment.wind.layers.{k}." for k in range(len(wind["layers"]))]
+        layers = [(drawn(f"{n}speed_mps", layer["speed_mps"]), drawn(f"{n}from_deg", layer["from_deg"]))
+                  for n, layer in zip(names, wind["layers"])]  # fmt: skip
+    elif wind["model"] == "profile":
+        layers = []
+    else:
+        layers = [(drawn("environment.wind.speed_mps", wind["speed_mps"]),
+                   drawn("environment.wind.from_deg", wind["from_deg"]))]  # fmt: skip
+    result = {"azimuth_deg": float(np.degrees(np.arctan2(azimuth_east, azimuth_north)) % 360.0), "wind": None}
+    if layers:
+        speed, from_deg = (np.concatenate(values) for values in zip(*layers))
+        north, east = resultant(from_deg + 180.0, speed)
+        mean_speed = float(speed.mean())
+        ratio = float(np.hypot(north, east) / mean_speed) if mean_speed > 0 else 0.0
+        result["wind"] = {"speed_mps": mean_speed, "north_mps": north, "east_mps": east, "resultant": ratio,
+                          "from_deg": float(np.degrees(np.arctan2(-east, -north)) % 360.0),
+                          "spread": ratio < SPREAD_RESULTANT}  # fmt: skip
+    return result
+
+
+def _draw_launch_and_wind(ax: Axes, run: Run, length_m: float) -> None:
+    """The rail azimuth and the mean wind (where it blows to) as arrows of ``length_m`` [m] from the pad; the
+    mean wind speed in words when the directions are spread (see :data:`SPREAD_RESULTANT`)."""
+    found = launch_and_wind(run)
+    if found is None:
+        return
+    arrows = [("tab:gray", found["azimuth_deg"], f"rail {found['azimuth_deg']:.0f}°")]
+    wind = found["wind"]
+    if wind is None:
+        note = "wind: from a profile file, not drawn"
+    elif wind["speed_mps"] == 0.0:
+        note = "calm: no wind"
+    elif wind["spread"]:
+        note = (f"mean wind speed {wind['speed_mps']:.1f} m/s, its direction\nspread over the flights (vector mean "
+                f"{wind['resultant'] * wind['speed_mps']:.1f} m/s): no arrow")  # fmt: skip
+    else:
+        note = f"mean wind {wind['speed_mps']:.1f} m/s from {wind['from_deg']:.0f}°\n(the arrow: where it blows to)"
+        arrows.append(("tab:cyan", (wind["from_deg"] + 180.0) % 360.0, f"wind from {wind['from_deg']:.0f}°"))
+    for color, towards_deg, label in arrows:
+        tip = (length_m * np.sin(np.radians(towards_deg)), length_m * np.cos(np.radians(towards_deg)))  # (east, north)
+        ax.annotate("", xy=tip, xytext=(0.0, 0.0), arrowprops={"arrowstyle": "-|>", "color": color, "linewidth": 2.0},
+                    zorder=6)  # fmt: skip
+        ax.annotate(label, xy=tip, xytext=(3, 3), textcoords="offset points", color=color, fontsize="small", zorder=6)
+    ax.plot([], [], color=arrows[-1][0] if len(arrows) > 1 else "none", linewidth=2.0, label=note)  # a legend line
 
 
 def _area_label(area_m2: float) -> str:
@@ -34,7 +118,9 @@ def plot_impacts(
     """Impact points of ok realizations with their confidence ellipses.
 
     East [m] on the x axis, north [m] on the y axis, equal aspect; the pad (origin) and the
-    mean impact point are marked. Failed realizations are not drawn but counted in the title;
+    mean impact point are marked, with the rail azimuth and the mean wind from the pad (see
+    :func:`launch_and_wind`). Failed realizations that landed are drawn apart, one marker per
+    status, and counted in the legend (those without an impact point only counted in the title);
     ellipses are omitted when fewer than 3 ok impact points exist. Draws on ``ax`` if given
     (else on a new figure, without pyplot) and saves to ``path`` (PNG at 150 dpi) if given.
     """
@@ -43,19 +129,71 @@ def plot_impacts(
     n_total = len(run.outputs)
     n_ok = int(run.ok.sum())
 
-    _scatter(ax, north, east, "tab:blue", label="impacts")
+    _scatter(ax, north, east, "tab:blue", label=f"ok impacts ({n_ok})")
+    status = run.outputs["status"].to_numpy()
+    for i, code in enumerate(sorted(set(status[~run.ok].tolist()))):
+        where = run.has_impact & (status == code)
+        if where.any():
+            f_north, f_east = run.ok_impacts(where)
+            ax.scatter(f_east, f_north, s=22, marker=_FAILED_MARKERS[i % len(_FAILED_MARKERS)], color="k",
+                       linewidths=1.0, label=f"status {code} ({int(where.sum())} landed): "
+                       f"{_shorten(run.status_codes.get(code, 'unknown'))}", zorder=5)  # fmt: skip
     ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
+    reach = np.hypot(*run.ok_impacts(run.has_impact))
+    _draw_launch_and_wind(ax, run, 0.4 * float(reach.max()) if reach.size else 100.0)
     if north.size >= 3:
         for i, level in enumerate(levels):
-            _ellipse(ax, confidence_ellipse(north, east, level), _ELLIPSE_COLORS[i % len(_ELLIPSE_COLORS)],
-                     f"{100 * level:g} % ellipse")  # fmt: skip
+            ellipse = confidence_ellipse(north, east, level)
+            _ellipse(ax, ellipse, _ELLIPSE_COLORS[i % len(_ELLIPSE_COLORS)],
+                     f"{100 * level:g} % ellipse, {100 * ellipse.contains(north, east).mean():.1f} % inside")  # fmt: skip
+        ax.text(0.01, 0.01, "ellipses: a Gaussian fit to the ok impact points (sample mean and covariance);\n"
+                "'inside' is the fraction of ok points each actually holds", transform=ax.transAxes,
+                fontsize="small", va="bottom", ha="left", bbox={"facecolor": "white", "alpha": 0.8, "linewidth": 0})
         ax.plot(east.mean(), north.mean(), "kX", markersize=9, label="mean impact", zorder=4)
 
     title = f"{run.attrs.get('campaign_name', '')}: impact points, {n_ok} ok / {n_total}"
+    missing = int((~run.ok & ~run.has_impact).sum())
+    title += f", seed {run.attrs.get('seed')}"
     if n_ok < n_total:
-        title += f"\n({n_total - n_ok} failed realizations not shown)"
+        title += f"\n{n_total - n_ok} failed (not in the ellipses), {missing} of them without an impact point"
     _finish(fig, ax, title, path)
     return fig
+
+
+_HISTOGRAMS = (("apogee", "apogee above the pad", "m"), ("impact_distance", "impact distance from the pad", "m"),
+               ("landing_speed", "landing speed", "m/s"))  # fmt: skip
+
+
+def plot_histograms(run: Run, folder: str | Path, bins: int = 30) -> dict[Path, Figure]:
+    """Histograms of apogee [m], impact distance from the pad [m] and landing speed [m/s], written to
+    ``folder`` as ``apogee.png``, ``impact_distance.png`` and ``landing_speed.png``: the ok flights, and
+    stacked on them in grey the failed flights that landed (same bins); N of each in the title and the
+    legend, flights without the value (no impact point, NaN) counted in the title. Returns path -> figure."""
+    out = run.outputs
+    values = {"apogee": out["apogee_agl_m"].to_numpy(float), "landing_speed": out["impact_speed_mps"].to_numpy(float),
+              "impact_distance": np.hypot(out["impact_north_m"].to_numpy(float), out["impact_east_m"].to_numpy(float))}
+    landed_failed = ~run.ok & run.has_impact
+    figures = {}
+    for stem, label, unit in _HISTOGRAMS:
+        x = values[stem]
+        ok, failed = x[run.ok & np.isfinite(x)], x[landed_failed & np.isfinite(x)]
+        fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+        ax = fig.add_subplot()
+        edges = np.histogram_bin_edges(np.concatenate([ok, failed]), bins=bins)
+        ax.hist([ok, failed], bins=edges, stacked=True, color=["tab:blue", "0.55"],
+                label=[f"ok ({ok.size})", f"failed, landed ({failed.size})"])  # fmt: skip
+        title = f"{run.attrs.get('campaign_name', '')}: {label}, N = {ok.size + failed.size} of {len(x)} flights"
+        if ok.size + failed.size < len(x):
+            title += f"\n({len(x) - ok.size - failed.size} without a value: failed in flight or no impact point)"
+        ax.set_title(title)
+        ax.set_xlabel(f"{label} [{unit}]")
+        ax.set_ylabel("flights")
+        ax.grid(True, alpha=0.4)
+        ax.legend(fontsize="small")
+        path = Path(folder) / f"{stem}.png"
+        _save(fig, path)
+        figures[path] = fig
+    return figures
 
 
 def plot_comparison(

@@ -56,6 +56,12 @@ class Run:
         """Boolean mask of ok realizations with finite impact coordinates."""
         return self.ok & np.isfinite(self._impacts()).all(axis=0)
 
+    @property
+    def has_impact(self) -> np.ndarray:
+        """Boolean mask of realizations, of any status, with finite impact coordinates (a tumbled flight
+        still lands; one stopped on a NaN state has no impact point)."""
+        return np.isfinite(self._impacts()).all(axis=0)
+
     def _impacts(self) -> np.ndarray:
         """(2, N) impact points (north, east) [m] of every realization."""
         return self.outputs[["impact_north_m", "impact_east_m"]].to_numpy(dtype=float).T
@@ -178,12 +184,15 @@ def summarize(run: Run) -> dict:
     """JSON-serialisable summary of a run.
 
     Keys: ``campaign_name``, ``seed``, ``rocketmc_version``, ``n_realizations``, ``n_ok``,
-    ``status`` (list of code/message/count, every known code and any other code seen),
+    ``status`` (list of code/message/count, every known code and any other code seen), ``failed`` (per
+    code seen other than 0: code, message, count, ``landed`` with an impact point and
+    ``no_impact_point``; these flights are left out of the metrics and ellipses),
     ``metrics`` (per output except status, over ok realizations and finite values: unit, n,
     mean, std (ddof=1), min, p5, p50, p95, max) and ``impact_ellipses`` (``Ellipse.to_dict()``
     at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
     ``impact_ellipse_95_intervals`` (``bootstrap_intervals`` of the 95 % ellipse's area and centre;
-    None below ``MIN_BOOTSTRAP_POINTS``).
+    None below ``MIN_BOOTSTRAP_POINTS``) and ``warnings`` (what ``run`` warned of: the nominal rocket's static
+    stability, flights beyond the aerodynamic method's validity; the file's ``warnings`` attribute).
     """
     ok = run.ok
     status = run.outputs["status"].to_numpy()
@@ -198,17 +207,22 @@ def summarize(run: Run) -> dict:
         }
         for c in codes
     ]
+    failed = [
+        {"code": s["code"], "message": s["message"], "count": s["count"],
+         "landed": int((run.has_impact & (status == s["code"])).sum()),
+         "no_impact_point": int((~run.has_impact & (status == s["code"])).sum())}
+        for s in status_rows if s["code"] != 0 and s["count"]
+    ]  # fmt: skip
     metrics = {
         name: {"unit": run.units.get(name, ""), **_metric_stats(col.to_numpy(dtype=float)[ok])}
         for name, col in run.outputs.items()
         if name != "status"
     }
     north, east = run.ok_impacts()
-    ellipses = (
-        [confidence_ellipse(north, east, level).to_dict() for level in SUMMARY_LEVELS]
-        if north.size >= 3
-        else []
-    )
+    ellipses = [
+        {**e.to_dict(), "coverage": float(e.contains(north, east).mean())}
+        for e in (confidence_ellipse(north, east, level) for level in SUMMARY_LEVELS)
+    ] if north.size >= 3 else []  # fmt: skip
     intervals = bootstrap_intervals(north, east, 0.95) if north.size >= MIN_BOOTSTRAP_POINTS else None
     return {
         "campaign_name": run.attrs.get("campaign_name", ""),
@@ -217,9 +231,11 @@ def summarize(run: Run) -> dict:
         "n_realizations": len(run.outputs),
         "n_ok": int(ok.sum()),
         "status": status_rows,
+        "failed": failed,
         "metrics": metrics,
         "impact_ellipses": ellipses,
         "impact_ellipse_95_intervals": intervals,
+        "warnings": json.loads(run.attrs.get("warnings", "[]")),
     }
 
 
@@ -255,6 +271,7 @@ def format_summary(summary: dict) -> str:
         f"Campaign {summary['campaign_name']!r}  (seed {summary['seed']}, "
         f"rocketmc {summary['rocketmc_version']})",
         f"Realizations: {summary['n_realizations']} total, {summary['n_ok']} ok",
+        *(f"Warning: {line}" for line in summary["warnings"]),
         "",
         "Status",
         *_table(
@@ -263,8 +280,17 @@ def format_summary(summary: dict) -> str:
             align="rrl",
         ),
         "",
-        "Metrics (ok realizations)",
     ]
+    if summary["failed"]:
+        out += ["Failed realizations (not in the metrics or ellipses; their impact points are drawn apart)"]
+        out += _table(
+            ["code", "count", "landed", "no impact point", "message"],
+            [[str(s["code"]), str(s["count"]), str(s["landed"]), str(s["no_impact_point"]), s["message"]]
+             for s in summary["failed"]],
+            align="rrrrl",
+        )  # fmt: skip
+        out.append("")
+    out += ["Metrics (ok realizations)"]
     stat_keys = ["mean", "std", "min", *_PERCENTILES, "max"]
     out += _table(
         ["metric", "unit", "n", *stat_keys],
@@ -277,7 +303,7 @@ def format_summary(summary: dict) -> str:
     out += ["", "Impact ellipses (north/east from pad)"]
     if summary["impact_ellipses"]:
         out += _table(
-            ["level", "N [m]", "E [m]", "a [m]", "b [m]", "az [deg]", "area [km^2]", "area [m^2]"],
+            ["level", "N [m]", "E [m]", "a [m]", "b [m]", "az [deg]", "area [km^2]", "area [m^2]", "inside"],
             [
                 [
                     f"{100 * e['level']:g} %",
@@ -288,12 +314,14 @@ def format_summary(summary: dict) -> str:
                     f"{e['orientation_deg']:.1f}",
                     f"{e['area_m2'] / 1e6:.4g}",
                     f"{e['area_m2']:.0f}",
+                    f"{100 * e['coverage']:.1f} %",
                 ]
                 for e in summary["impact_ellipses"]
             ],
-            align="r" * 8,
+            align="r" * 9,
         )
-        out.append("  (N, E: centre; a, b: semi-axes; az: major axis, clockwise from north)")
+        out.append("  (N, E: centre; a, b: semi-axes; az: major axis, clockwise from north; inside: the fraction of "
+                   "ok impact points inside, the check on the ellipses' Gaussian fit)")  # fmt: skip
     if summary["impact_ellipse_95_intervals"]:
         i = summary["impact_ellipse_95_intervals"]
         out.append(f"  95 % ellipse, 95 % bootstrap intervals: area {i['area_m2'][0] / 1e6:.4g}–{i['area_m2'][1] / 1e6:.4g} "
