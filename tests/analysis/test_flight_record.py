@@ -79,3 +79,17 @@ def test_centre_of_pressure_of_the_linear_model(campaign):
     air = AirData(*(jnp.asarray(x) for x in (100.0, 0.0, 0.0, 0.3, 6000.0, 1.1, 1500.0)))
     x_cp = float(centre_of_pressure_at(aero, air, jnp.asarray(0.0)))
     assert x_cp == pytest.approx(-37.2959 / 24.0744 * 0.15, rel=1e-9)  # linear in α: the slope is exact
+
+
+def test_a_controlled_flight_records_its_canards_and_integrators():
+    """lynx_ballistic_ctrl_1s's nominal flight: four canard columns within the servos' limit, neutral on the
+    rail (the window opens 1 s after liftoff) and working in the window; the integrators at rest on the rail."""
+    record = flight_record(load_campaign(CAMPAIGNS / "lynx_ballistic_ctrl_1s.toml"))
+    s, limit = record.series, record.campaign.config.gnc.servo.limit_deg
+    canards = s[[f"canard_{i}" for i in range(1, 5)]].to_numpy()
+    on_rail = s["time"].to_numpy() < record.summary["rail_exit_time_s"]
+    assert on_rail.sum() > 10 and np.all(canards[on_rail] == 0.0)
+    assert np.all(np.abs(canards) <= limit * (1 + 1e-12))  # clipped at the limit; rounding of the degree conversion
+    assert np.abs(canards).max() > 1.0  # the controller steers (the thesis's case saturates in its first second)
+    integrators = s[["integrator_p", "integrator_q", "integrator_r"]].to_numpy()
+    assert np.all(integrators[on_rail] == 0.0) and np.abs(integrators).max() > 0.0
