@@ -62,17 +62,16 @@ def _deflections(p, state):
 def _at_start(p, state):
     """What the model computes at the start of the period beginning at ``state`` (SI, body FRD / NED)."""
     _, _, gust = period_gust(p, state)
-    f = loads(state.t, state.body, p, _deflections(p, state), gust, state.events)
-    body = state.body
+    deflections = _deflections(p, state)
+    f = loads(state.t, state.body, p, deflections, gust, state.events)
     cp_x = centre_of_pressure_at(p.rocket.aero, f.air, f.mass.cg_x)
-    aero_force_n = body.q_nb.rotate(f.aero_force_b)
-    v_air_b = body.q_nb.rotate_inverse(body.v_n - p.environment.wind.velocity_n(-body.r_n.z) - gust)
     return {
-        "loads": f, "gust_n": gust, "deflections": _deflections(p, state),
-        "total_alpha": jnp.arccos(jnp.clip(v_air_b.x / jnp.maximum(v_air_b.norm(), 1e-9), -1.0, 1.0)),
+        "loads": f, "deflections": deflections,
+        # u/V = cos α cos β for α = atan2(w, u), β = asin(v/V): the body axis against the air-relative velocity
+        "total_alpha": jnp.arccos(jnp.clip(jnp.cos(f.air.alpha) * jnp.cos(f.air.beta), -1.0, 1.0)),
         "cp_x": cp_x,
         "static_margin": (f.mass.cg_x - cp_x) / p.rocket.aero.reference_length_m,
-        "aero_power": aero_force_n.dot(body.v_n),
+        "aero_power": state.body.q_nb.rotate(f.aero_force_b).dot(state.body.v_n),
     }  # fmt: skip
 
 
@@ -208,7 +207,7 @@ def _series(campaign: Campaign, states, samples, summary) -> tuple[pd.DataFrame,
         "total_alpha": (deg(samples["total_alpha"]), "deg", "angle between the body axis and the air-relative velocity"),
         "mach": (air.mach, "1", "Mach number"),
         "dynamic_pressure": (air.qbar, "Pa", "dynamic pressure ½ρV²"),
-        "density": (air.density, "kg/m^3", "air density (ISA)"),
+        "density": (air.density, "kg/m^3", "air density (the campaign's atmosphere)"),
         "thrust": (f.thrust, "N", "motor thrust along the body axis"),
         **{f"aero_force_{a}": (getattr(f.aero_force_b, a), "N", f"aerodynamic force, body {a} (FRD)") for a in "xyz"},
         **{f"chute_force_{n}": (getattr(f.chute_force_n, a), "N", f"parachutes' force, {n}")
