@@ -69,6 +69,16 @@ class _Client(Client):
             raise
 
 
+def _closed_by_peer(error: Exception) -> bool:
+    """Whether reaching a scheduler failed because the port accepted the connection and closed it.
+
+    Dask retries a connect attempt closed before it saw the stream open (a refused one too) until its timeout,
+    then raises a timed-out ``OSError`` from the last attempt's ``CommClosedError``; a refused attempt's comes
+    from a ``ConnectionRefusedError``."""
+    closed = error if isinstance(error, CommClosedError) else error.__cause__
+    return isinstance(closed, CommClosedError) and not isinstance(closed.__cause__, ConnectionRefusedError)
+
+
 def worker_env(n_workers: int, devices: int) -> dict[str, str]:
     """Environment of each of ``n_workers`` local worker processes on a machine of ``devices`` XLA CPU
     devices (one per core, ``rocketmc.__init__``): ``devices // n_workers`` devices each, at least 1.
@@ -99,9 +109,9 @@ def cluster(scheduler: str | None = None, workers: int | None = None):
     except (TimeoutError, asyncio.TimeoutError):  # an OSError, asyncio's too from Python 3.11 on
         raise ClusterError(f"{where}: no answer from a Dask scheduler within {deadline:g} s (the port accepted the "
                            "connection)") from None  # fmt: skip
-    except CommClosedError:
-        raise ClusterError(f"{where}: the connection was closed without answering as a Dask scheduler") from None
     except (OSError, ValueError) as e:
+        if _closed_by_peer(e):
+            raise ClusterError(f"{where}: the connection was closed without answering as a Dask scheduler") from None
         raise ClusterError(f"{where}: no Dask scheduler reachable there ({e})") from None
     except ImportError:  # the scheduler refused this client's packages
         raise
