@@ -10,6 +10,7 @@ import argparse
 import functools
 import json
 import os
+import re
 import signal
 import sys
 from pathlib import Path
@@ -47,6 +48,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     """Fly ``campaign``'s missing chunks with ``run_chunks`` (``campaign.run_chunks`` or its Dask twin,
     ``where`` describing the cluster) and write the result file."""
     from .analysis.ellipse import AreaConvergence
+    from .analysis.flight_record import write_trajectories
     from .campaign import ResultWriter
     from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings, stability_warnings
     from .campaign.runner import chunking
@@ -56,7 +58,10 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     if out.is_file() and not (args.resume or args.force):
         raise RocketmcError(f"--out {out}: the file exists; use --resume to continue it or --force to replace it")
     chunk_size, n_chunks = chunking(campaign, args.chunk_size)
-    writer = ResultWriter(out, campaign, chunk_size, resume=args.resume)
+    realizations = _trajectories(args.trajectories, campaign)
+    interval = args.trajectory_interval
+    asked = None if realizations is None else {"realizations": realizations, "interval_s": interval}
+    writer = ResultWriter(out, campaign, chunk_size, resume=args.resume, trajectories=asked)
     if writer.already_complete:
         print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
         return 0
@@ -115,11 +120,37 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
         validity.extend(outputs_validity_warnings(campaign, {n: f["outputs"][n][()] for n in VALIDITY_OUTPUTS}))
         return warnings + validity
 
-    writer.finish(n_rows, kept_warnings)
+    kept = [i for i in realizations or () if i < (n_rows or cfg.n_realizations)]
+    if len(kept) < len(realizations or ()):
+        validity.append(f"--trajectories: realizations {', '.join(str(i) for i in realizations if i not in kept)} are "
+                        f"beyond the N = {n_rows} reached; their trajectories are not kept")  # fmt: skip
+    if kept:
+        log(f"trajectories of realizations {', '.join(map(str, kept))}, every {interval:g} s (compiling, then flying "
+            "each)")  # fmt: skip
+    writer.finish(n_rows, kept_warnings, lambda group: write_trajectories(group, campaign, kept, interval))
     rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
     log(f"wrote {out} ({flown} flights flown in this run{rate})")
     _warn(validity)
     return 0
+
+
+def _trajectories(text: str | None, campaign) -> list[int] | None:
+    """The realizations of ``run --trajectories I,J,...``, ascending and once each (None: not given); a one-line
+    RocketmcError for a malformed list, a realization outside the campaign or more than ``MAX_TRAJECTORIES``."""
+    from .analysis.flight_record import check_realization
+
+    if text is None:
+        return None
+    if not re.fullmatch(r"\d+(,\d+)*", text):
+        raise RocketmcError(f"--trajectories {text}: expected realization indices separated by commas (0,5,17)")
+    realizations = sorted({int(word) for word in text.split(",")})
+    if len(realizations) > MAX_TRAJECTORIES:
+        raise RocketmcError(f"--trajectories: {len(realizations)} realizations, at most {MAX_TRAJECTORIES} are kept")
+    try:
+        check_realization(campaign, realizations[-1], "--trajectories")
+    except ValueError as e:
+        raise RocketmcError(str(e)) from None
+    return realizations
 
 
 def _warn(lines: list[str]) -> None:
@@ -455,6 +486,12 @@ def _fly_one(args) -> int:
 
 MAX_STATIC_S = 86_400.0
 """Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
+MAX_TRAJECTORIES = 100
+"""Most realizations whose trajectories ``run --trajectories`` keeps: with the default interval, 0.1 s, and the
+flights' longest time (``simulation.max_time_s``, 300 s by default) each at most 3002 rows of 43 float64 columns
+(53 with a controller) and the phase, ≤ 1.3 MB."""
+TRAJECTORY_INTERVAL_S = 0.1
+"""The kept trajectories' sample interval by default (``run --trajectory-interval``) [s]."""
 MAX_MACH = 10.0
 """Largest Mach number ``aero derivatives`` evaluates at (tables are clamped at their edge beyond theirs)."""
 FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
@@ -543,6 +580,12 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--sensors", choices=("on", "off"),
                      help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
                           "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
+    run.add_argument("--trajectories", metavar="I,J,...",
+                     help=f"keep the time series of these realizations (at most {MAX_TRAJECTORIES}), decimated, in the "
+                          "file's /trajectories: each flown after the chunks, bit for bit as fly flies it")  # fmt: skip
+    run.add_argument("--trajectory-interval", type=float, default=TRAJECTORY_INTERVAL_S, metavar="S",
+                     help="with --trajectories, keep the first sample of each S seconds and the last (default "
+                          "%(default)g)")  # fmt: skip
     cluster = run.add_mutually_exclusive_group()
     cluster.add_argument("--scheduler", metavar="ADDRESS",
                          help="fly the chunks on the Dask cluster of this scheduler (tcp://host:8786; needs "
@@ -674,6 +717,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("-n/--n must be at least 1")
     if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
         parser.error("--until-converged must be a percentage in (0, 100]")
+    if args.command == "run" and not 0 < args.trajectory_interval < float("inf"):
+        parser.error("--trajectory-interval must be a positive time in seconds")
     if getattr(args, "outside_radius", None) is not None and not 0 < args.outside_radius < float("inf"):
         parser.error("--outside-radius must be a positive distance in metres")
     if len(getattr(args, "files", [])) == 1:

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import NamedTuple
 from xml.etree import ElementTree
 
+import h5py
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -147,11 +148,11 @@ class FlightRecord:
         return f"{self.campaign.config.name}, {which}"
 
 
-def check_realization(campaign: Campaign, realization: int | None) -> None:
-    """ValueError naming ``--realization`` unless it is None (the nominal flight) or a realization of ``campaign``."""
+def check_realization(campaign: Campaign, realization: int | None, option: str = "--realization") -> None:
+    """ValueError naming ``option`` unless ``realization`` is None (the nominal flight) or one of ``campaign``."""
     n = campaign.config.n_realizations
     if realization is not None and not 0 <= realization < n:
-        raise ValueError(f"--realization {realization}: not a realization of {campaign.config.name} (0 to {n - 1})")
+        raise ValueError(f"{option} {realization}: not a realization of {campaign.config.name} (0 to {n - 1})")
 
 
 def flight_record(campaign: Campaign, realization: int | None = None) -> FlightRecord:
@@ -311,14 +312,47 @@ def write_series(record: FlightRecord, path: str | Path) -> Path:
                         "realization": -1 if record.realization is None else record.realization,
                         "status": record.status, "status_message": Status(record.status).message,
                         "rocketmc_version": __version__})  # fmt: skip
-        for name, m in record.columns.items():
-            values = record.series[name].to_numpy()
-            data = f.create_dataset(f"series/{name}", data=values.astype("S") if values.dtype == object else values)
-            data.attrs.update({"unit": m.unit, "description": m.meaning})
+        _write_columns(f.create_group("series"), record.series, record.columns)
         for name, value in record.summary.items():
             data = f.create_dataset(f"summary/{name}", data=value)
             data.attrs.update({"unit": metric(name).unit, "description": metric(name).meaning})
     return path
+
+
+def _write_columns(group: h5py.Group, series: pd.DataFrame, columns: dict[str, Metric]) -> None:
+    """Each column of ``series`` as a dataset of ``group`` (strings as bytes) with ``unit`` and ``description``."""
+    for name, m in columns.items():
+        values = series[name].to_numpy()
+        data = group.create_dataset(name, data=values.astype("S") if values.dtype == object else values)
+        data.attrs.update({"unit": m.unit, "description": m.meaning})
+
+
+TRAJECTORY_RULE = ("the flight record's series (rocketmc fly --realization I) decimated: the first sample in each "
+                   "interval_s-long bin of time [k*interval_s, (k+1)*interval_s) and the last (at or after impact)")
+"""What ``/trajectories`` of a result file holds (its ``description`` attribute)."""
+
+
+def decimate(series: pd.DataFrame, interval_s: float) -> pd.DataFrame:
+    """The rows of ``series`` that are the first in each ``interval_s``-long bin of time [k·S, (k+1)·S) [s], and
+    its last row: at most t_end/S + 2 rows, every row when the periods are longer than S."""
+    bins = np.floor(series["time"].to_numpy() / interval_s)
+    keep = np.diff(bins, prepend=-1.0) > 0
+    keep[-1] = True
+    return series[keep].reset_index(drop=True)
+
+
+def write_trajectories(group: h5py.Group, campaign: Campaign, realizations, interval_s: float) -> None:
+    """Fly each of ``realizations`` of ``campaign`` (``flight_record``, the campaign's bits) and write its series,
+    ``decimate``d to ``interval_s`` [s], to ``group/<index>``: one dataset per column in the series' order, with
+    ``unit`` and ``description``; the flight's ``status``, ``status_message`` and ``samples`` (before decimation)
+    as the subgroup's attributes; ``TRAJECTORY_RULE`` as the group's ``description``."""
+    group.attrs["description"] = TRAJECTORY_RULE
+    for index in realizations:
+        record = flight_record(campaign, index)
+        g = group.create_group(str(index), track_order=True)
+        g.attrs.update({"status": record.status, "status_message": Status(record.status).message,
+                        "samples": len(record.series)})  # fmt: skip
+        _write_columns(g, decimate(record.series, interval_s), record.columns)
 
 
 def trajectory_kml(record: FlightRecord) -> str:

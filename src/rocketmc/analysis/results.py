@@ -4,7 +4,9 @@ Layout read here: ``/outputs/<name>`` 1-D datasets (row = realization, ``attrs["
 ``/outputs/status`` int (0 = ok, ``attrs["codes"]`` a JSON object code -> message),
 ``/inputs/<name>`` 1-D sampled dispersions, and root attributes such as ``campaign_name``,
 ``seed``, ``n_realizations`` and ``complete``. Impact points are north/east [m] from the pad
-(NED world frame).
+(NED world frame). ``/trajectories/<index>`` (only with ``run --trajectories``): realization index's time
+series, one 1-D dataset per column (``attrs["unit"]``, ``attrs["description"]``), decimated as the group's
+``description`` says, every ``interval_s`` attribute seconds.
 """
 
 from __future__ import annotations
@@ -157,6 +159,21 @@ def load_run(path: str | Path) -> Run:
     if len(inputs.columns) and len(inputs) != len(outputs):
         raise ResultFileError(f"{path}: {len(inputs)} input rows but {len(outputs)} output rows")
     return Run(outputs, inputs, attrs, {**input_units, **units}, codes)
+
+
+def load_trajectories(path: str | Path) -> dict[int, pd.DataFrame]:
+    """The kept trajectories of a complete result file (``run --trajectories``), by realization index, ascending:
+    each a DataFrame of the columns in their stored order (strings decoded), units and meanings in its
+    ``attrs["units"]`` (column -> (unit, description)), its flight's status code in ``attrs["status"]``; empty
+    when the run kept none."""
+    with _open(path) as f:
+        trajectories = {}
+        for name, group in sorted(f.get("trajectories", {}).items(), key=lambda item: int(item[0])):
+            frame = pd.DataFrame({key: ds.asstr()[()] if ds.dtype.kind == "S" else ds[()] for key, ds in group.items()})
+            frame.attrs = {"units": {key: (_native(ds.attrs["unit"]), _native(ds.attrs["description"]))
+                                     for key, ds in group.items()}, "status": int(group.attrs["status"])}  # fmt: skip
+            trajectories[int(name)] = frame
+        return trajectories
 
 
 def _stat(x: float) -> float | None:

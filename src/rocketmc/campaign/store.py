@@ -11,6 +11,9 @@ the same way) and removes the folder: a file at ``<out>`` is complete.
 against the set-up given: a manifest of another set-up or edited by hand, a chunk of another set-up,
 one renamed, truncated or damaged, or a file that is not the run's are refused in one line, and
 nothing is overwritten.
+A run that keeps trajectories (``rocketmc run --trajectories``) says which in its manifest (a resume must ask for
+the same) and flies them in ``finish()``, into the file before it is marked complete: a run killed while flying
+them keeps its chunks and resumes to fly them again.
 """
 
 from __future__ import annotations
@@ -37,6 +40,8 @@ MANIFEST_FORMAT = 2
 CHUNK_FILE = re.compile(r"chunk_(\d{6})\.h5")
 GROUPS = ("outputs", "inputs")
 """The groups of a chunk file and of the result file."""
+TRAJECTORIES = "trajectories"
+"""The result file's group of kept trajectories (``run --trajectories``), absent when none were asked for."""
 SHOWN_DIFFERENCES = 4
 """Differing set-up fields a refusal names before '...'."""
 
@@ -71,10 +76,13 @@ def _read_manifest(path: Path) -> dict:
 class ResultWriter:
     """Writes one campaign's results: ``write(chunk, index)`` per finished chunk, then ``finish()``.
 
+    ``trajectories``: the realizations whose trajectories the file keeps and their sample interval,
+    ``{"realizations": [i, ...], "interval_s": s}`` (None: none), kept in the manifest.
     ``already_complete``: resuming found no partial folder but a complete result file at ``out`` of
-    the same set-up, which is kept (``finish()`` does nothing)."""
+    the same set-up and trajectories, which is kept (``finish()`` does nothing)."""
 
-    def __init__(self, out: str | Path, campaign: Campaign, chunk_size: int, resume: bool = False):
+    def __init__(self, out: str | Path, campaign: Campaign, chunk_size: int, resume: bool = False,
+                 trajectories: dict | None = None):  # fmt: skip
         self.out = Path(out)
         self.dir = partial_dir(self.out)
         self.n = campaign.config.n_realizations
@@ -82,6 +90,9 @@ class ResultWriter:
         self.setup = setup(campaign, self.chunk_size)
         self.fingerprint = fingerprint(self.setup)
         self.manifest = {"format": MANIFEST_FORMAT, "fingerprint": self.fingerprint, "setup": self.setup}
+        self.trajectories = trajectories
+        if trajectories is not None:  # absent otherwise: the manifests of runs without trajectories are unchanged
+            self.manifest["trajectories"] = trajectories
         self.already_complete = False
         self._chunks: set[int] = set()  # indices of the chunks written and checked
         self._names: dict[str, set[str]] | None = None  # the datasets of every chunk, from the first checked
@@ -113,6 +124,9 @@ class ResultWriter:
         try:
             with h5py.File(self.out, "r") as f:
                 complete, found = bool(f.attrs.get("complete", False)), f.attrs.get("fingerprint")
+                kept = f.get(TRAJECTORIES)
+                kept = None if kept is None else {"realizations": kept.attrs["realizations"].tolist(),
+                                                  "interval_s": float(kept.attrs["interval_s"])}  # fmt: skip
         except OSError:
             raise ResumeError(f"{self.out}: no partial run {self.dir.name} to resume, and not a result file") from None
         if not complete:
@@ -120,6 +134,9 @@ class ResultWriter:
         if found != self.fingerprint:
             raise ResumeError(f"{self.out}: complete already, from another set-up (or an older rocketmc); "
                               "nothing to resume")  # fmt: skip
+        if kept != self.trajectories:
+            raise ResumeError(f"{self.out}: complete already, keeping other trajectories than asked (--trajectories, "
+                              "--trajectory-interval); nothing to resume")  # fmt: skip
 
     def _check_manifest(self, found: dict) -> None:
         if found == self.manifest:
@@ -206,11 +223,13 @@ class ResultWriter:
         with h5py.File(self._chunk_path(index), "r") as chunk:
             return {name: chunk["outputs"][name][()] for name in names}
 
-    def finish(self, n_rows: int | None = None, warnings=None) -> Path:
+    def finish(self, n_rows: int | None = None, warnings=None, write_trajectories=None) -> Path:
         """Check the chunks and gather them into ``<out>`` (complete), then remove the partial folder.
         ``n_rows``: the realizations kept when a run stopped early (``--until-converged``), the first
         chunks' rows; ``warnings``: a function of the gathered file returning warning lines, kept in its
-        ``warnings`` attribute (a JSON list) before the file is marked complete."""
+        ``warnings`` attribute (a JSON list) before the file is marked complete; ``write_trajectories``: with
+        ``trajectories`` asked for, a function writing them into the group ``/trajectories`` it is given (whose
+        ``realizations`` and ``interval_s`` attributes say what was asked for), before the file is marked complete."""
         if self.already_complete:
             return self.out
         n = self.n if n_rows is None else n_rows
@@ -236,6 +255,11 @@ class ResultWriter:
                         for name, values in data.items():
                             values = values[: max(0, n - start)]
                             self._dataset(f, group, name, values, n)[start : start + len(values)] = values
+                if self.trajectories is not None:
+                    group = f.create_group(TRAJECTORIES)
+                    group.attrs.update({"realizations": np.asarray(self.trajectories["realizations"], dtype=np.int64),
+                                        "interval_s": self.trajectories["interval_s"]})  # fmt: skip
+                    write_trajectories(group)
                 if warnings is not None:
                     f.attrs["warnings"] = json.dumps(warnings(f))
                 f.attrs["complete"] = True
