@@ -122,8 +122,9 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
 
     kept = [i for i in realizations or () if i < (n_rows or cfg.n_realizations)]
     if len(kept) < len(realizations or ()):
-        validity.append(f"--trajectories: realizations {', '.join(str(i) for i in realizations if i not in kept)} are "
-                        f"beyond the N = {n_rows} reached; their trajectories are not kept")  # fmt: skip
+        left = ",".join(str(i) for i in realizations if i not in kept)
+        validity.append(f"--trajectories {left}: beyond the {n_rows} realizations --until-converged kept, so not in "
+                        "/trajectories")  # fmt: skip
     if kept:
         log(f"trajectories of realizations {', '.join(map(str, kept))}, every {interval:g} s (compiling, then flying "
             "each)")  # fmt: skip

@@ -4,6 +4,7 @@ one line with nothing left; a killed run resumes to the same file; a run without
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import pytest
 
 from rocketmc.analysis import load_outputs, load_trajectories
 from rocketmc.analysis import flight_record as flight_record_module
+from rocketmc.analysis.ellipse import AreaConvergence
 from rocketmc.analysis.flight_record import flight_record
 from rocketmc.campaign import load_campaign
 from rocketmc.cli import main
@@ -172,3 +174,23 @@ def test_a_run_killed_while_flying_them_resumes_to_the_same_file(kept, campaign_
     assert_same(contents(out), contents(kept))
     assert main([*argv, "--resume", "--trajectory-interval", "0.5"]) == 2  # complete already, with other ones
     assert "keeping other trajectories than asked" in capsys.readouterr().err
+
+
+def test_trajectories_beyond_the_n_until_converged_reaches_are_left_out(campaign_file, tmp_path, capsys, monkeypatch):
+    """--until-converged stopped at 4 of 6 (convergence made to come after 2 chunks of 2: the test is of what is
+    kept, not of the bootstrap): realization 4's trajectory is left out, with a warning the file keeps."""
+
+    def after_two_chunks(self):
+        self.converged = self.n >= 4
+        return self.converged
+
+    monkeypatch.setattr(AreaConvergence, "check", after_two_chunks)
+    out = tmp_path / "converged.h5"
+    argv = ["run", str(campaign_file), *ARGS, "--chunk-size", "2", "--until-converged", "50", "--trajectories", "1,4"]
+    assert main([*argv, "--out", str(out)]) == 0
+    warning = "--trajectories 4: beyond the 4 realizations --until-converged kept, so not in /trajectories"
+    assert f"rocketmc: warning: {warning}" in capsys.readouterr().err.splitlines()
+    assert list(load_trajectories(out)) == [1]
+    with h5py.File(out) as f:
+        assert f.attrs["n_realizations"] == 4 and list(f["trajectories"].attrs["realizations"]) == [1, 4]
+        assert warning in json.loads(f.attrs["warnings"])
