@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rocketmc.analysis import load_outputs, load_trajectories
+from rocketmc.analysis import format_summary, load_outputs, load_run, load_trajectories, summarize
 from rocketmc.analysis import flight_record as flight_record_module
 from rocketmc.analysis.ellipse import AreaConvergence
 from rocketmc.analysis.flight_record import flight_record
@@ -124,6 +124,14 @@ def test_a_run_without_trajectories_is_unchanged(kept, campaign_file, tmp_path):
     plain, with_them = contents(out), contents(kept)
     assert "trajectories" in with_them and "trajectories" not in plain
     assert_same(plain, {k: v for k, v in with_them.items() if not k.startswith("trajectories")})  # same fingerprint
+    assert load_trajectories(out) == {} and "Trajectories" not in format_summary(summarize(load_run(out)))
+
+
+def test_report_says_which_trajectories_are_kept(kept, capsys):
+    assert main(["report", str(kept)]) == 0
+    assert "Trajectories kept (rocketmc.analysis.load_trajectories): realizations 1, 4" in capsys.readouterr().out
+    assert main(["report", str(kept), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["trajectories"] == list(KEPT)
 
 
 def exit_code(argv) -> int:

@@ -38,13 +38,15 @@ class ResultFileError(RocketmcError, ValueError):
 @dataclass(frozen=True)
 class Run:
     """A loaded campaign: outputs and inputs per realization, root attributes, units
-    (dataset name -> unit string) and status codes (code -> message)."""
+    (dataset name -> unit string), status codes (code -> message) and the realizations whose trajectories
+    the file keeps (``load_trajectories``)."""
 
     outputs: pd.DataFrame
     inputs: pd.DataFrame
     attrs: dict
     units: dict[str, str]
     status_codes: dict[int, str]
+    trajectories: tuple[int, ...] = ()
 
     @property
     def ok(self) -> np.ndarray:
@@ -142,11 +144,12 @@ def load_inputs(path: str | Path) -> pd.DataFrame:
 
 
 def load_run(path: str | Path) -> Run:
-    """Outputs, inputs, root attributes, units and status codes of a complete result file."""
+    """Outputs, inputs, root attributes, units, status codes and kept trajectories of a complete result file."""
     with _open(path) as f:
         outputs, units = _read_group(f, "outputs", path)
         inputs, input_units = _read_group(f, "inputs", path)
         attrs = {k: _native(v) for k, v in f.attrs.items()}
+        trajectories = tuple(sorted(int(name) for name in f.get("trajectories", {})))
         codes = {}
         if "status" in f["outputs"] and "codes" in f["outputs/status"].attrs:
             try:
@@ -158,7 +161,7 @@ def load_run(path: str | Path) -> Run:
         raise ResultFileError(f"{path}: {len(outputs)} output rows but n_realizations = {expected}")
     if len(inputs.columns) and len(inputs) != len(outputs):
         raise ResultFileError(f"{path}: {len(inputs)} input rows but {len(outputs)} output rows")
-    return Run(outputs, inputs, attrs, {**input_units, **units}, codes)
+    return Run(outputs, inputs, attrs, {**input_units, **units}, codes, trajectories)
 
 
 def load_trajectories(path: str | Path) -> dict[int, pd.DataFrame]:
@@ -209,7 +212,8 @@ def summarize(run: Run) -> dict:
     at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
     ``impact_ellipse_95_intervals`` (``bootstrap_intervals`` of the 95 % ellipse's area and centre;
     None below ``MIN_BOOTSTRAP_POINTS``) and ``warnings`` (what ``run`` warned of: the nominal rocket's static
-    stability, flights beyond the aerodynamic method's validity; the file's ``warnings`` attribute).
+    stability, flights beyond the aerodynamic method's validity; the file's ``warnings`` attribute) and
+    ``trajectories`` (the realizations whose trajectories the file keeps, ascending).
     """
     ok = run.ok
     status = run.outputs["status"].to_numpy()
@@ -253,6 +257,7 @@ def summarize(run: Run) -> dict:
         "impact_ellipses": ellipses,
         "impact_ellipse_95_intervals": intervals,
         "warnings": json.loads(run.attrs.get("warnings", "[]")),
+        "trajectories": list(run.trajectories),
     }
 
 
@@ -288,6 +293,8 @@ def format_summary(summary: dict) -> str:
         f"Campaign {summary['campaign_name']!r}  (seed {summary['seed']}, "
         f"rocketmc {summary['rocketmc_version']})",
         f"Realizations: {summary['n_realizations']} total, {summary['n_ok']} ok",
+        *([f"Trajectories kept (rocketmc.analysis.load_trajectories): realizations "
+           f"{', '.join(map(str, summary['trajectories']))}"] if summary["trajectories"] else []),  # fmt: skip
         *(f"Warning: {line}" for line in summary["warnings"]),
         "",
         "Status",
