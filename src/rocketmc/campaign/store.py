@@ -127,7 +127,7 @@ class ResultWriter:
                 kept = f.get(TRAJECTORIES)
                 kept = None if kept is None else {"realizations": kept.attrs["realizations"].tolist(),
                                                   "interval_s": float(kept.attrs["interval_s"])}  # fmt: skip
-        except OSError:
+        except (OSError, KeyError):  # KeyError: a /trajectories group without what was asked for, not rocketmc's
             raise ResumeError(f"{self.out}: no partial run {self.dir.name} to resume, and not a result file") from None
         if not complete:
             raise ResumeError(f"{self.out}: no partial run {self.dir.name} to resume, and the file is incomplete")
