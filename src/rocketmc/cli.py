@@ -387,6 +387,7 @@ def _site_campaign(name: str):
 
 def _navigate(args) -> int:
     from .analysis import replay as nav_replay
+    from .analysis.flight_log import read_pitot_static
     from .analysis.sensor_log import read_sensor_log
     from .campaign.config import FiltersConfig
     from .campaign.model import filter_params
@@ -404,6 +405,11 @@ def _navigate(args) -> int:
         log = read_sensor_log(args.log_dir)
     except ValueError as e:
         raise RocketmcError(str(e)) from None
+    if args.static_source == "pitot":
+        try:
+            log["baro"] = read_pitot_static(args.log_dir)
+        except (FileNotFoundError, ValueError) as e:
+            raise RocketmcError(f"--static-source pitot: {e}") from None
     if args.plot_dir:  # before the replay: a folder that cannot be made is said at once
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     params = nav_replay.retuned(filter_params(campaign), None if args.barometer is None else args.barometer == "on",
@@ -416,7 +422,7 @@ def _navigate(args) -> int:
         "(compiling, then replaying)")  # fmt: skip
     q_nb0 = (nav_replay.accelerometer_attitude(log, launch.azimuth_deg) if args.initial_attitude == "accelerometer"
              else nav_replay.rail_attitude(launch.elevation_deg, launch.azimuth_deg))  # fmt: skip
-    nav = nav_replay.replay(log, params, q_nb0, site)
+    nav = nav_replay.replay(log, params, q_nb0, site, barometer_max_mach=args.barometer_max_mach)
     try:
         windows = nav_replay.flight_windows(nav, log)
     except ValueError as e:
@@ -426,7 +432,9 @@ def _navigate(args) -> int:
     top = int(nav["height_m"].idxmax())
     gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
     print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
-          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'}, field direction σ "
+          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'} ({args.static_source}"
+          + ("" if args.barometer_max_mach is None else f", locked out above Mach {args.barometer_max_mach:g}")
+          + f"), field direction σ "
           f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): " + ", ".join(
               f"{name} {'off' if gate is None else f'{gate:g}'}" for name, gate in
               (("magnetometer", params.field_gate), ("GNSS", params.gnss_gate), ("barometer", params.altitude_gate))))  # fmt: skip
@@ -656,6 +664,13 @@ def build_parser() -> argparse.ArgumentParser:
     navigate.add_argument("--plot-dir", "--plot", dest="plot_dir", metavar="DIR",
                           help="folder for the figures (height, velocity, its direction, attitude; --plot: its old spelling)")  # fmt: skip
     navigate.add_argument("--barometer", choices=("on", "off"), help="the barometric height update (default: the campaign's)")
+    navigate.add_argument("--static-source", choices=("baro", "pitot"), default="baro",
+                          help="the static pressure of the barometer's samples (the update and the barometric height "
+                               "compared with): the log's barometer, or the static port of its pitot_42hz.csv (the "
+                               "real log's) (default: baro)")  # fmt: skip
+    navigate.add_argument("--barometer-max-mach", type=float, metavar="M",
+                          help="lock the barometer out while the filters' estimated speed exceeds Mach M "
+                               "(default: never)")  # fmt: skip
     navigate.add_argument("--gnss", choices=("all", "horizontal"),
                           help="GNSS updates of every axis or of north and east only (default: the campaign's)")  # fmt: skip
     navigate.add_argument("--gnss-after", type=float, metavar="S",
@@ -738,6 +753,8 @@ def main(argv: list[str] | None = None) -> int:
         spreads = [*(args.gnss_std or ()), *(() if args.field_direction_std is None else (args.field_direction_std,))]
         if not all(0 < v < float("inf") for v in spreads) or not 0 <= (args.gnss_after or 0.0) < float("inf"):
             parser.error("--gnss-std and --field-direction-std must be positive, --gnss-after at least 0")
+        if args.barometer_max_mach is not None and not 0 < args.barometer_max_mach < float("inf"):
+            parser.error("--barometer-max-mach must be a positive Mach number")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench}  # fmt: skip
     try:

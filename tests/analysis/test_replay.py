@@ -3,8 +3,9 @@
 One simulated flight (the nominal Lynx with the thesis's sensors but a NEO-M9N receiver, no controller, 25 s: boost, coast and apogee) is
 flown once with its avionics bus and true state recorded, and its log built as ``rocketmc sensors simulate`` builds
 it (in memory). Against it: the replay of the log is the filter fed from the flight's own bus (the log's plumbing:
-timing, freshness, units, latitude/longitude); the replayed estimates track the truth. On the real Roccaraso log: the
-barometer-on descent (the issue's acceptance), the CLI's outputs and errors.
+timing, freshness, units, latitude/longitude); the replayed estimates track the truth; the barometer's lock-out above
+a Mach number. On the real Roccaraso log: the barometer-on descent (the issue's acceptance), the pitot's static port
+as the barometer, the CLI's outputs and errors.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import pandas as pd
 import pytest
 
 from rocketmc.analysis import replay
-from rocketmc.analysis.flight_log import ROCCARASO_2021
+from rocketmc.analysis.flight_log import ROCCARASO_2021, read_pitot_static
 from rocketmc.analysis.sensor_log import LOG_FILES, read_sensor_log, write_sensor_log
 from rocketmc.campaign import campaign_from_dict, load_campaign
 from rocketmc.campaign.model import filter_params
@@ -142,6 +143,16 @@ def test_replayed_navigation_tracks_the_truth(flight):
     assert np.sqrt(np.mean(angle**2)) < 6.0
 
 
+def _glitched(log):
+    """``log`` with a barometer glitch: its first 5 samples from 6 s 3 kPa low (~300 m high); and their indices."""
+    log = dict(log)
+    baro = log["baro"].copy()
+    glitch = np.flatnonzero(baro["t_s"].to_numpy() >= 6.0)[:5]
+    baro.loc[glitch, "pressure_pa"] -= 3000.0
+    log["baro"] = baro
+    return log, glitch
+
+
 def test_the_barometers_gate_rejects_a_glitch_and_accepts_the_rest(flight):
     """A glitch of the simulated log's barometer (5 samples 3 kPa low, ~300 m high, at 6 s: the real log's transonic
     drop is 250 m) is rejected by a gate of 100 (10σ; its normalised innovation squared is ~3000) and every other
@@ -150,11 +161,8 @@ def test_the_barometers_gate_rejects_a_glitch_and_accepts_the_rest(flight):
     params = _tuned(flight, barometer=True, gnss="all", gnss_after_s=0.0, gnss_std=GNSS_STD)
     q_nb0, _ = _start(flight)
     site = flight["campaign"].config.site
-    log = dict(flight["log"])
-    baro = log["baro"].copy()
-    glitch = np.flatnonzero(baro["t_s"].to_numpy() >= 6.0)[:5]
-    baro.loc[glitch, "pressure_pa"] -= 3000.0
-    log["baro"] = baro
+    log, glitch = _glitched(flight["log"])
+    baro = log["baro"]
     plain = replay.replay(log, params, q_nb0, site)
     gated = replay.replay(log, dataclasses.replace(params, altitude_gate=100.0), q_nb0, site)
     wide = replay.replay(log, dataclasses.replace(params, altitude_gate=1e4), q_nb0, site)
@@ -166,6 +174,61 @@ def test_the_barometers_gate_rejects_a_glitch_and_accepts_the_rest(flight):
     # the glitch pulls the ungated height by metres (3 kPa over σ 5 m, gain ~0.1-0.3 a sample); the gated one not at all
     assert (plain["height_m"] - gated["height_m"])[after].abs().max() > 1.0
     assert wide.equals(plain)  # nothing rejected: the same estimates, bit for bit
+
+
+def test_the_barometers_lock_out_above_a_mach_number(flight):
+    """Locked out above Mach 0.3 (~100 m/s: the simulated Lynx is faster from ~1 s to ~9 s), the barometer's samples
+    of that span are unused: a 3 kPa glitch at 6 s inside it leaves every estimate bit-identical to the log without
+    it, while the samples locked out move the estimate (against no lock-out); a lock-out above the flight's speeds
+    (Mach 10) is no lock-out, bit for bit."""
+    params = _tuned(flight, barometer=True, gnss="all", gnss_after_s=0.0, gnss_std=GNSS_STD)
+    q_nb0, _ = _start(flight)
+    site = flight["campaign"].config.site
+    glitched, glitch = _glitched(flight["log"])
+    baro = glitched["baro"]
+    plain = replay.replay(flight["log"], params, q_nb0, site)
+    locked = replay.replay(flight["log"], params, q_nb0, site, barometer_max_mach=0.3)
+    locked_glitched = replay.replay(glitched, params, q_nb0, site, barometer_max_mach=0.3)
+    # the premise: the estimate before each glitched sample's tick is faster than Mach 0.3
+    at = np.searchsorted(plain["t_s"].to_numpy(), baro["t_s"].to_numpy()[glitch] - replay.SAME_TIME_S)
+    before = locked.iloc[at - 1]
+    v_n = Vec3(*(jnp.asarray(before[f"v_{d}_mps"].to_numpy()) for d in ("north", "east", "down")))
+    mach = replay.estimated_mach(v_n, jnp.asarray(before["down_m"].to_numpy()), site.altitude_m)
+    assert np.all(np.asarray(mach) > 0.3)
+    assert locked_glitched.equals(locked)
+    # the locked-out samples' pull: metres (the pad pressure's and the 300 Pa bias's few metres, at gains ~0.1-0.3)
+    assert (locked["height_m"] - plain["height_m"]).abs().max() > 0.1
+    assert replay.replay(flight["log"], params, q_nb0, site, barometer_max_mach=10.0).equals(plain)
+
+
+def test_the_estimated_mach_number():
+    """``estimated_mach`` against the ISA by hand: 200, 0, −100 m/s at 1000 m above a pad 500 m above sea level, the
+    speed of sound √(γ R T) at the ISA temperature of the geopotential height of 1500 m (1e-12: rounding)."""
+    z = 1500.0
+    h = 6356766.0 * z / (6356766.0 + z)
+    sound = math.sqrt(1.4 * 287.05287 * (288.15 - 0.0065 * h))
+    mach = replay.estimated_mach(Vec3(200.0, 0.0, -100.0), -1000.0, 500.0)
+    assert float(mach) == pytest.approx(math.hypot(200.0, 100.0) / sound, rel=1e-12)
+
+
+def test_the_pitot_static_port_as_a_barometer():
+    """``flight_log.read_pitot_static`` on the real log: 5384 samples 24 ms apart (its t_nominal_s), the file's
+    static_pressure_pa as pressure_pa; as a barometer its new samples (4092: the port repeats 1292) give the ISA
+    height of the hypsometric formula by hand, here at its highest sample before the drogue (17.64 s) above sample 0,
+    its pad pressure (1e-6 m: rounding)."""
+    pitot = read_pitot_static(ROCCARASO_2021)
+    assert len(pitot) == 5384 and list(pitot.columns) == ["t_s", "pressure_pa"]
+    np.testing.assert_allclose(pitot["t_s"].to_numpy()[[1, -1]], [0.024, 5383 * 0.024], rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(pitot["pressure_pa"].to_numpy()[[0, 1, 735]], [88731.4141, 89149.5781, 74484.1953])
+    height = replay.barometric_height({"baro": pitot}, 88731.4141)
+    assert len(height) == 4092
+
+    def isa_height(p):  # geometric height [m] of the ISA troposphere's level p [Pa], by hand
+        h = 288.15 / 0.0065 * (1.0 - (p / 101325.0) ** (287.05287 * 0.0065 / 9.80665))
+        return 6356766.0 * h / (6356766.0 - h)
+
+    top = height[np.isclose(height["t_s"], 17.64)]
+    assert float(top["height_m"].iloc[0]) == pytest.approx(isa_height(74484.1953) - isa_height(88731.4141), abs=1e-6)
 
 
 def test_navigate_reads_a_simulated_log(flight, tmp_path, capsys):
@@ -185,10 +248,11 @@ def test_navigate_reads_a_simulated_log(flight, tmp_path, capsys):
     assert len(pd.read_csv(out)) == len(back["imu"])
 
 
-def _real_log(directory: Path) -> Path:
-    """A copy of the real log in ``directory``: the CLI's tests run on it, as a log that ``read_sensor_log`` reads."""
+def _real_log(directory: Path, *extra: str) -> Path:
+    """A copy of the real log in ``directory``: the CLI's tests run on it, as a log that ``read_sensor_log`` reads,
+    with the ``extra`` files of the real log too."""
     directory.mkdir()
-    for file, _ in LOG_FILES.values():
+    for file in (*(file for file, _ in LOG_FILES.values()), *extra):
         shutil.copy(Path(str(ROCCARASO_2021 / file)), directory)
     return directory
 
@@ -208,6 +272,22 @@ def test_navigate_writes_the_estimates_and_figures(tmp_path, capsys):
     assert sorted(p.name for p in plots.iterdir()) == sorted(replay.FIGURES)
 
 
+def test_navigate_with_the_pitot_static_port(tmp_path, capsys):
+    """``rocketmc navigate --static-source pitot`` (the thesis's tuning, barometer on, locked out above Mach 0.5): the
+    barometer's samples are the pitot's static port, measured from its pad pressure, sample 0 (88731.4141 Pa: the only
+    one before liftoff is sensed; its next, of 0.024 s, reaches the filters at the liftoff's tick, 0.04 s), and the
+    estimated height follows that barometric height within 10 m RMS through the coast and the descent (measured:
+    6.7 m and 3.4 m)."""
+    log = _real_log(tmp_path / "log", "pitot_42hz.csv")
+    code = main(["navigate", str(log), "--barometer", "on", "--static-source", "pitot", "--barometer-max-mach", "0.5",
+                 "--quiet"])  # fmt: skip
+    out = capsys.readouterr().out
+    assert code == 0 and "barometer on (pitot, locked out above Mach 0.5)" in out and "pad pressure 88731.4 Pa" in out
+    rms = {line.split("[m]")[0].strip(): float(line.split()[-2])
+           for line in out.splitlines() if "height − barometric" in line}  # fmt: skip
+    assert rms["height − barometric height, coast"] <= 10.0 and rms["height − barometric height, descent"] <= 10.0
+
+
 def _fails(capsys, args, *needles):
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
@@ -216,7 +296,8 @@ def _fails(capsys, args, *needles):
 
 def test_navigate_refuses_what_it_cannot_replay(tmp_path, capsys):
     """One line, exit code 2 and no output file: a campaign initialised on the pad (the log starts at liftoff), a log
-    missing a file, a log missing a column, an unknown campaign name."""
+    missing a file, a log missing a column, an unknown campaign name, the pitot's static port of a log without its
+    file, a lock-out Mach number not positive."""
     log = _real_log(tmp_path / "log")
     out = tmp_path / "nav.csv"
     pad = tmp_path / "pad.toml"
@@ -230,6 +311,13 @@ def test_navigate_refuses_what_it_cannot_replay(tmp_path, capsys):
     baro.write_text(baro.read_text().replace("pressure_pa", "pressure", 1))
     _fails(capsys, ["navigate", str(log), "--out", str(out)], LOG_FILES["baro"][0], "pressure_pa")
     _fails(capsys, ["navigate", str(log), "--site", "no_such_campaign"], "no_such_campaign", "lynx_roccaraso_2021")
+    shutil.copy(Path(str(ROCCARASO_2021 / LOG_FILES["baro"][0])), log)
+    _fails(capsys, ["navigate", str(log), "--static-source", "pitot", "--out", str(out)], "--static-source pitot",
+           "pitot_42hz.csv")  # fmt: skip
+    with pytest.raises(SystemExit) as info:  # an argument's check: argparse's exit
+        main(["navigate", str(log), "--barometer-max-mach", "0", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert info.value.code == 2 and len(err.splitlines()) == 1 and "--barometer-max-mach" in err, err
     assert not out.exists() and not list(tmp_path.glob("*.writing"))
 
 

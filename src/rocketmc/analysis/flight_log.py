@@ -132,6 +132,14 @@ def read_flight_log(directory: str | os.PathLike | Traversable, site: Site, desc
     return FlightLog(**streams, site=site, description=description)
 
 
+def read_pitot_static(directory: str | os.PathLike | Traversable) -> pd.DataFrame:
+    """The pitot's static port of a log in the Lynx layout (``pitot_42hz.csv``'s ``static_pressure_pa``) as a
+    barometer stream: ``t_s`` = the first sample's time + sample × period [s], the period from ``t_nominal_s``, and
+    ``pressure_pa`` [Pa] (its own level: the real log's reads 3050 Pa above the MS5803 on the pad and after landing)."""
+    root = Path(directory) if isinstance(directory, (str, os.PathLike)) else directory
+    return _read_stream(root / _STREAMS["pitot"][0], None, {"static_pressure_pa": "pressure_pa"})
+
+
 def load_roccaraso_2021() -> FlightLog:
     """The Lynx flight at Roccaraso, 18 Sept 2021, vendored in ``data/flights/roccaraso_2021``."""
     return read_flight_log(ROCCARASO_2021, ROCCARASO_SITE, "Skyward Lynx, Roccaraso, 18 Sept 2021: Cesaroni "

@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from ..env.atmosphere import isa
 from ..env.site import north_east_m
 from ..gnc.navigation import LIFTOFF_SPECIFIC_FORCE_MPS2, FilterParams, Measurements, filter_step, initial_filters
 from ..math import Quat, Vec3
@@ -118,27 +119,41 @@ def log_ticks(log: Mapping[str, pd.DataFrame], site) -> Ticks:
     return Ticks(t, m, moving)
 
 
+def estimated_mach(v_n: Vec3, down_m, site_altitude_m):
+    """The Mach number of the estimated velocity ``v_n`` [m/s, NED] at the estimated position's ``down_m`` [m below
+    the pad] in the ISA over a pad ``site_altitude_m`` [m above mean sea level]: its ground speed over the speed of
+    sound (the wind, ~10 m/s, moves it by < 0.03)."""
+    return v_n.norm() / isa(site_altitude_m - down_m).speed_of_sound
+
+
 @jax.jit
-def _scan(params: FilterParams, q_nb0: Quat, r_n0: Vec3, m: Measurements, t, moving):
-    """The filters' states after each tick, stacked (``filter_step`` over the ticks from ``initial_filters``)."""
+def _scan(params: FilterParams, q_nb0: Quat, r_n0: Vec3, m: Measurements, t, moving, max_mach, site_altitude_m):
+    """The filters' states after each tick, stacked (``filter_step`` over the ticks from ``initial_filters``); a
+    barometer sample is withheld (not fresh) while the estimate before its tick is faster than ``max_mach`` [-]."""
 
     def tick(state, inputs):
         m, t, moving = inputs
         gnss = m.gnss.at[2].set(state.position.r_n.z)  # no GNSS altitude (NO_GNSS_ALTITUDE_STD_M)
-        _, state = filter_step(params, state, dataclasses.replace(m, gnss=gnss), t, moving, False)
+        slow = estimated_mach(state.position.v_n, state.position.r_n.z, site_altitude_m) <= max_mach
+        m = dataclasses.replace(m, gnss=gnss, pressure_fresh=m.pressure_fresh & slow)
+        _, state = filter_step(params, state, m, t, moving, False)
         return state, state
 
     return jax.lax.scan(tick, initial_filters(params, q_nb0, r_n0), (m, t, moving))[1]
 
 
 def replay(log: Mapping[str, pd.DataFrame], params: FilterParams, q_nb0: Quat, site,
-           r_n0: Vec3 | None = None) -> pd.DataFrame:  # fmt: skip
+           r_n0: Vec3 | None = None, barometer_max_mach: float | None = None) -> pd.DataFrame:  # fmt: skip
     """The filters' a-posteriori estimates at each of the log's IMU ticks (module docstring).
 
     params: the filters (``campaign.model.filter_params``; ``pad_samples`` must be 0: the log starts at liftoff);
     q_nb0: the attitude at liftoff (body FRD → NED; the rail's, ``sim.params.Launch.from_angles``); site: the origin
-    of north and east (``latitude_deg``, ``longitude_deg``); r_n0: the position at liftoff [m, NED from the site]
-    (default: the first GNSS fix's north and east, at the pad's height: the barometric heights are the pad's).
+    of north and east (``latitude_deg``, ``longitude_deg``) and the pad's ``altitude_m`` [m above mean sea level];
+    r_n0: the position at liftoff [m, NED from the site] (default: the first GNSS fix's north and east, at the pad's
+    height: the barometric heights are the pad's); barometer_max_mach: the barometer's lock-out [-], its samples
+    unused while the filter's estimate (of the tick before) is faster (``estimated_mach``: a static port's error
+    grows with the dynamic pressure; None: never locked out). The barometer's samples are ``log["baro"]``'s: another
+    static source replaces that stream (``flight_log.read_pitot_static``).
 
     Columns: t_s [s since liftoff]; moving (liftoff sensed); q_w, q_x, q_y, q_z (body → NED) and yaw_deg, pitch_deg,
     roll_deg (3-2-1); north_m, east_m, down_m [m from the site] and height_m (= −down) [m above the pad];
@@ -159,7 +174,9 @@ def replay(log: Mapping[str, pd.DataFrame], params: FilterParams, q_nb0: Quat, s
     gnss_std = params.position.gnss_position_std._replace(z=jnp.asarray(NO_GNSS_ALTITUDE_STD_M))
     params = dataclasses.replace(params, position=dataclasses.replace(params.position, gnss_position_std=gnss_std))
     r_n0 = Vec3(*(jnp.asarray(c, dtype=float) for c in r_n0))
-    states = jax.tree_util.tree_map(np.asarray, _scan(params, q_nb0, r_n0, ticks.measurements, ticks.t_s, ticks.moving))
+    max_mach = np.inf if barometer_max_mach is None else float(barometer_max_mach)
+    states = jax.tree_util.tree_map(np.asarray, _scan(params, q_nb0, r_n0, ticks.measurements, ticks.t_s, ticks.moving,
+                                                      max_mach, float(site.altitude_m)))  # fmt: skip
     att, pos = states.attitude, states.position
     yaw, pitch, roll = (np.degrees(np.asarray(a)) for a in att.q_nb.to_euler())
     attitude_std = np.degrees(np.sqrt(np.diagonal(att.cov, axis1=1, axis2=2)))
@@ -276,17 +293,18 @@ def _rms_max(error) -> tuple[float, float]:
     return float(np.sqrt(np.mean(error**2))), float(np.max(np.abs(error)))
 
 
-def navigation_metrics(nav: pd.DataFrame, log: Mapping[str, pd.DataFrame],
-                       windows: Mapping[str, tuple[float, float]]) -> dict[str, float]:  # fmt: skip
+def navigation_metrics(nav: pd.DataFrame, log: Mapping[str, pd.DataFrame], windows: Mapping[str, tuple[float, float]],
+                       pad_pressure_pa: float | None = None) -> dict[str, float]:  # fmt: skip
     """The estimates against the log's own measurements over each window W of ``windows`` ({W: (start, end)} [s],
-    e.g. ``flight_windows``'s), as root mean square and maximum magnitude: the height less the barometric height
-    (``height_{rms,max}_W_m``); the estimated velocity's flight-path angle and heading less the GNSS velocity's
-    (``gamma_{rms,max}_W_deg``, ``heading_{rms,max}_W_deg``, headings where the GNSS's horizontal speed exceeds
-    ``MIN_HORIZONTAL_SPEED_MPS``); the angle between the estimated body axis and the GNSS velocity
-    (``body_to_velocity_{rms,max}_W_deg``); and the mean of the attitude's pitch less the GNSS flight-path angle
+    e.g. ``flight_windows``'s), as root mean square and maximum magnitude: the height less the barometric height of
+    ``log["baro"]`` above ``pad_pressure_pa`` [Pa] (default: the filters' own, ``pad_pressure``; another static
+    source's heights are measured from its own pad level) (``height_{rms,max}_W_m``); the estimated velocity's
+    flight-path angle and heading less the GNSS velocity's (``gamma_{rms,max}_W_deg``, ``heading_{rms,max}_W_deg``,
+    headings where the GNSS's horizontal speed exceeds ``MIN_HORIZONTAL_SPEED_MPS``); the angle between the
+    estimated body axis and the GNSS velocity (``body_to_velocity_{rms,max}_W_deg``); and the mean of the attitude's pitch less the GNSS flight-path angle
     (``pitch_minus_gamma_mean_W_deg``). NaN where a window holds no sample."""
     metrics = {}
-    height = barometric_height(log, pad_pressure(nav))
+    height = barometric_height(log, pad_pressure(nav) if pad_pressure_pa is None else pad_pressure_pa)
     comparison = gnss_comparison(nav, log)
     for name, (start, end) in windows.items():
         h = height[(height["t_s"] >= start) & (height["t_s"] <= end)]
@@ -325,29 +343,34 @@ def _decorate(axes, windows, end_s: float) -> None:
 
 def plot_navigation(runs: Mapping[str, pd.DataFrame], log: Mapping[str, pd.DataFrame],
                     windows: Mapping[str, tuple[float, float]], directory: str | Path, title: str = "",
-                    prefix: str = "") -> list[Path]:  # fmt: skip
+                    prefix: str = "", heights: Mapping[str, pd.DataFrame] | None = None) -> list[Path]:  # fmt: skip
     """The ``FIGURES`` in ``directory`` (created if need be), each run of ``runs`` ({label: ``replay``'s frame}, in
-    its colour) against the log (black): height against the barometric height, with the difference; velocity N, E, D
+    its colour) against the log (black): height against the barometric heights ``heights`` ({label:
+    ``barometric_height``'s frame}, the first black and the reference of the difference, the others grey; default:
+    the log's barometer above the first run's pad pressure), with the difference; velocity N, E, D
     against the GNSS's; the velocity's flight-path angle and heading against the GNSS velocity's, through the coast;
     the attitude's pitch against the GNSS flight-path angle and the angle between the body axis and the GNSS velocity,
     through the coast. File names: ``prefix`` then the ``FIGURES``'. Returns the paths written."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     label = f"{title}: " if title else ""
-    first = next(iter(runs.values()))
-    height = barometric_height(log, pad_pressure(first))
+    if heights is None:
+        heights = {"barometer (ISA)": barometric_height(log, pad_pressure(next(iter(runs.values()))))}
+    reference = next(iter(heights))
+    height = heights[reference]
     end = windows["descent"][1] + 5.0
     colors = dict(zip(runs, _RUN_COLORS))
     paths = [directory / f"{prefix}{name}" for name in FIGURES]
 
     fig, (ax, ax_error) = _panels(2, f"{label}height above the pad", 3.2)
-    ax.plot(height["t_s"], height["height_m"], color="black", linewidth=1.0, label="barometer (ISA)")
+    for name, h in heights.items():
+        ax.plot(h["t_s"], h["height_m"], color="black" if name == reference else "0.6", linewidth=1.0, label=name)
     for name, nav in runs.items():
         ax.plot(nav["t_s"], nav["height_m"], color=colors[name], linewidth=1.0, label=name)
         error = _at(nav, height["t_s"].to_numpy(), "height_m") - height["height_m"].to_numpy()
         ax_error.plot(height["t_s"], error, color=colors[name], linewidth=0.7)
     ax.set_ylabel("height [m]")
-    ax_error.set_ylabel("estimate − barometer [m]")
+    ax_error.set_ylabel(f"estimate − {reference} [m]")
     _decorate((ax, ax_error), windows, end)
     _save(fig, paths[0])
 
