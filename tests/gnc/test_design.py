@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+import scipy.linalg
 import scipy.signal
 
 from rocketmc.gnc.design import (
@@ -253,8 +254,18 @@ def test_schedule_names_an_interior_failing_point():
             point = point._replace(cy_delta=0.0, cn_delta=0.0, cm_delta=0.0, cn_yaw_delta=0.0)
         return point
 
-    with pytest.raises(ValueError, match=r"^LQI design at speed 200 m/s, altitude 1000 m: closed-loop spectral"):
+    with pytest.raises(ValueError, match=r"^LQI design at speed 200 m/s, altitude 1000 m: no stabilising DARE solution"):
         gain_schedule(stalled_at_200_1000, (100.0, 200.0, 300.0), (0.0, 1000.0))
+
+
+def test_a_returned_solution_that_does_not_stabilise_is_refused(monkeypatch):
+    # scipy returns a P (here zero: K = 0) whose closed loop is the open loop, unstable: refused with its radius.
+    # (On a pencil with eigenvalues on the unit circle scipy raises or returns such a P, by LAPACK's rounding.)
+    monkeypatch.setattr(scipy.linalg, "solve_discrete_are", lambda a, b, q, r: np.zeros_like(a))
+    ad, bd = np.array([[1.5]]), np.array([[1.0]])
+    with pytest.raises(ValueError, match=r"^LQI design at here: no stabilising DARE solution \(the closed loop's "
+                                         r"spectral radius 1.5 is not below 1\)$"):
+        lqi_gain(ad, bd, np.eye(1), np.eye(1), "here")
 
 
 @pytest.mark.parametrize("speeds", [(100.0, 50.0, 200.0), (), ((100.0, 200.0),)])

@@ -147,8 +147,9 @@ def lqi_gain(ad: np.ndarray, bd: np.ndarray, q: np.ndarray, r: np.ndarray, where
     """Infinite-horizon discrete LQR of (Ad, Bd) with weights Q (n, n) ⪰ 0 and R (m, m) ≻ 0.
 
     P solves the DARE (scipy.linalg.solve_discrete_are), K = (R + BᵀPB)⁻¹BᵀPA. Raises ValueError
-    naming ``where`` if the weights are not symmetric Q ⪰ 0, R ≻ 0, if scipy finds no stabilising
-    solution, or if the closed loop's spectral radius is not below 1.
+    naming ``where`` if the weights are not symmetric Q ⪰ 0, R ≻ 0, or if there is no stabilising solution:
+    scipy finds none, or the closed loop of the one it returns has a spectral radius not below 1 (which of the two
+    on a pencil with eigenvalues on the unit circle depends on LAPACK's rounding: the same refusal).
     """
     if not (np.allclose(q, q.T) and np.allclose(r, r.T)):
         raise ValueError(f"LQI design at {where}: the weights Q and R must be symmetric")
@@ -162,7 +163,8 @@ def lqi_gain(ad: np.ndarray, bd: np.ndarray, q: np.ndarray, r: np.ndarray, where
     gain = np.linalg.solve(r + bt_p @ bd, bt_p @ ad)
     spectral_radius = float(np.abs(np.linalg.eigvals(ad - bd @ gain)).max())
     if not np.isfinite(spectral_radius) or spectral_radius >= 1.0:
-        raise ValueError(f"LQI design at {where}: closed-loop spectral radius {spectral_radius:.9g} is not below 1")
+        raise ValueError(f"LQI design at {where}: no stabilising DARE solution (the closed loop's spectral radius "
+                         f"{spectral_radius:.9g} is not below 1)")  # fmt: skip
     at_p = ad.T @ p
     lhs = at_p @ ad - p - at_p @ bd @ gain + q  # AᵀPA − P − AᵀPB(R + BᵀPB)⁻¹BᵀPA + Q
     residual = float(np.linalg.norm(lhs) / np.linalg.norm(p))
