@@ -120,10 +120,10 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
         validity.extend(outputs_validity_warnings(campaign, {n: f["outputs"][n][()] for n in VALIDITY_OUTPUTS}))
         return warnings + validity
 
-    kept = [i for i in realizations or () if i < (n_rows or cfg.n_realizations)]
-    if len(kept) < len(realizations or ()):
-        left = ",".join(str(i) for i in realizations if i not in kept)
-        validity.append(f"--trajectories {left}: beyond the {n_rows} realizations --until-converged kept, so not in "
+    rows = n_rows or cfg.n_realizations
+    kept, left = [i for i in realizations or () if i < rows], [i for i in realizations or () if i >= rows]
+    if left:
+        validity.append(f"--trajectories {','.join(map(str, left))}: beyond the {n_rows} realizations --until-converged kept, so not in "
                         "/trajectories")  # fmt: skip
     if kept:
         log(f"trajectories of realizations {', '.join(map(str, kept))}, every {interval:g} s (compiling, then flying "
