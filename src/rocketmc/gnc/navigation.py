@@ -15,7 +15,6 @@ solution (the thesis fed the a-priori one forward, a tick late). Frames: NED fro
 from __future__ import annotations
 
 import dataclasses
-import functools
 
 import jax.numpy as jnp
 
@@ -176,12 +175,17 @@ def innovation_gate(gate: float | None, nis) -> jnp.ndarray:
 
 
 def _covariance_ok(state: FilterState):
-    """Both covariances finite with positive variances (a necessary condition of positive definiteness, cheap)."""
+    """Both covariances finite with positive variances (a necessary condition of positive definiteness, cheap).
+
+    The failed checks are counted by a dot product, not an elementwise chain: every leaf of the filters' state
+    selects on this flag, and XLA's CPU fusion copies an elementwise producer into each consumer (here ~36
+    kernels recomputing the covariance updates it depends on), while a dot's result is computed once."""
     p = state.position
     variances = [state.attitude.cov[i, i] for i in range(6)] + [*p.p_rr, *p.p_vv]
-    ok = functools.reduce(jnp.logical_and, [(v > 0.0) & jnp.isfinite(v) for v in variances])
     determinants = [rr * vv - rv * rv for rr, rv, vv in zip(p.p_rr, p.p_rv, p.p_vv)]
-    return functools.reduce(jnp.logical_and, [d > 0.0 for d in determinants], ok & jnp.all(jnp.isfinite(state.attitude.cov)))
+    checks = [(v > 0.0) & jnp.isfinite(v) for v in variances] + [d > 0.0 for d in determinants]
+    failed = ~jnp.concatenate([jnp.stack(checks), jnp.isfinite(state.attitude.cov).ravel()])
+    return jnp.ones(failed.shape, jnp.float32) @ failed.astype(jnp.float32) == 0.0
 
 
 @pytree_dataclass
