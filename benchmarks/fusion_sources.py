@@ -25,7 +25,7 @@ import re  # noqa: E402
 
 import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
-from kernel_profile import fused_sizes  # noqa: E402
+from kernel_profile import computations, fused_sizes, fusion_calls  # noqa: E402
 
 from rocketmc.campaign import load_campaign  # noqa: E402
 from rocketmc.campaign.runner import realization_params, sim_settings  # noqa: E402
@@ -65,15 +65,10 @@ def source_frames(hlo: str) -> dict[int, list[tuple[str, str, int]]]:
 
 def attribution(hlo: str, by_line: bool) -> tuple[collections.Counter, dict[str, set]]:
     """(fused operations, kernels they appear in) by rocketmc source function (or line)."""
-    frames = source_frames(hlo)
-    computations = {}
-    for block in re.split(r"\n(?=\S.*\{\n)", hlo):
-        name = re.match(r"(?:ENTRY )?%?(\S+)", block)
-        if name:
-            computations[name.group(1)] = block
+    frames, blocks = source_frames(hlo), computations(hlo)
     operations, kernels = collections.Counter(), collections.defaultdict(set)
-    for kernel, callee in re.findall(r"%([\w.-]+) = .*? fusion\(.*?calls=%([\w.-]+)", hlo):
-        for frame in re.findall(r"= \S+ [\w-]+\(.*stack_frame_id=(\d+)", computations[callee]):
+    for kernel, callee in fusion_calls(hlo):
+        for frame in re.findall(r"= \S+ [\w-]+\(.*stack_frame_id=(\d+)", blocks[callee]):
             ours = [f for f in frames.get(int(frame), []) if "/rocketmc/" in f[0]]
             source = "?" if not ours else f"{os.path.basename(ours[0][0])}:{ours[0][1]}" + (f":{ours[0][2]}" if by_line else "")
             operations[source] += 1

@@ -32,15 +32,25 @@ from rocketmc.campaign.runner import realization_params, sim_settings  # noqa: E
 from rocketmc.sim import flight  # noqa: E402
 
 
-def fused_sizes(hlo_text: str) -> dict[str, int]:
-    """Operations in the fused computation each fusion kernel calls, by kernel name."""
-    computations = {}
+def computations(hlo_text: str) -> dict[str, str]:
+    """Each computation's text in an HLO module, by name."""
+    blocks = {}
     for block in re.split(r"\n(?=\S.*\{\n)", hlo_text):
         name = re.match(r"(?:ENTRY )?%?(\S+)", block)
         if name:
-            computations[name.group(1)] = len(re.findall(r"= \S+ [\w-]+\(", block))
-    calls = re.findall(r"%([\w.-]+) = .*? fusion\(.*?calls=%([\w.-]+)", hlo_text)
-    return {kernel: computations.get(callee, 0) for kernel, callee in calls}
+            blocks[name.group(1)] = block
+    return blocks
+
+
+def fusion_calls(hlo_text: str) -> list[tuple[str, str]]:
+    """(kernel, the fused computation it calls) of each fusion in an HLO module."""
+    return re.findall(r"%([\w.-]+) = .*? fusion\(.*?calls=%([\w.-]+)", hlo_text)
+
+
+def fused_sizes(hlo_text: str) -> dict[str, int]:
+    """Operations in the fused computation each fusion kernel calls, by kernel name."""
+    sizes = {name: len(re.findall(r"= \S+ [\w-]+\(", block)) for name, block in computations(hlo_text).items()}
+    return {kernel: sizes.get(callee, 0) for kernel, callee in fusion_calls(hlo_text)}
 
 
 def main() -> None:
