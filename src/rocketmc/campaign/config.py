@@ -628,12 +628,12 @@ class AttitudeFilterConfig(_Strict):
     [deg/s] per axis (the thesis's P0 = I); the magnetometer update's innovation gate (``Gate``, ~2 degrees of
     freedom; the thesis has none)."""
 
-    gyro_noise_deg_s: StdDeviation = 60.0
-    bias_walk_deg_s2: StdDeviation = 10.0
-    field_direction_std: StdDeviation = 2.0
-    initial_attitude_std_deg: StdDeviation = ONE_RAD_DEG
-    initial_bias_std_deg_s: StdDeviation = ONE_RAD_DEG
-    field_gate: Gate = None
+    gyro_noise_deg_s: StdDeviation = Field(60.0, description="σ_v, the gyro's white-noise density the filter assumes")
+    bias_walk_deg_s2: StdDeviation = Field(10.0, description="σ_u, the gyro bias's random-walk density assumed")
+    field_direction_std: StdDeviation = Field(2.0, description="the measured unit field direction's std (R = σ² I)")
+    initial_attitude_std_deg: StdDeviation = Field(ONE_RAD_DEG, description="initial attitude std per axis (P0)")
+    initial_bias_std_deg_s: StdDeviation = Field(ONE_RAD_DEG, description="initial gyro-bias std per axis (P0)")
+    field_gate: Gate = Field(None, description="the magnetometer update's χ² innovation gate (none: off)")
 
 
 class PositionFilterConfig(_Strict):
@@ -645,19 +645,22 @@ class PositionFilterConfig(_Strict):
     and the barometer's innovation gates (``Gate``; 2 degrees of freedom per GNSS axis, 1 for the barometer; the
     thesis has none)."""
 
-    position_noise_m: StdDeviation = 2.0
-    velocity_noise_mps: StdDeviation = 1.0
-    gnss: Literal["all", "horizontal"] = "all"
-    gnss_after_s: float = Field(10.5, ge=0, le=MAX_FLIGHT_TIME_S)
-    gnss_position_std_m: list[StdDeviation] = Field([500.0, 500.0, 700.0], min_length=3, max_length=3)
-    gnss_velocity_std_mps: list[StdDeviation] = Field([50.0, 50.0, 70.0], min_length=3, max_length=3)
-    barometer: bool = False
-    altitude_std_m: StdDeviation = 5.0  # GNC.md's MS5803-class 50 Pa per sample over ρ·g: 4.2 m at sea level, 4.8 m at
-    # Lynx's 1.4 km pads (the thesis has no barometer update)
-    initial_position_std_m: StdDeviation = 1.0
-    initial_velocity_std_mps: StdDeviation = 1.0
-    gnss_gate: Gate = None
-    altitude_gate: Gate = None
+    position_noise_m: StdDeviation = Field(2.0, description="σ_r, process-noise density on the position, per √s")
+    velocity_noise_mps: StdDeviation = Field(1.0, description="σ_v, process-noise density on the velocity, per √s")
+    gnss: Literal["all", "horizontal"] = Field("all", description="the GNSS axes used: all, or north and east only")
+    gnss_after_s: float = Field(10.5, ge=0, le=MAX_FLIGHT_TIME_S, description="GNSS fixes used from this time on")
+    gnss_position_std_m: list[StdDeviation] = Field([500.0, 500.0, 700.0], min_length=3, max_length=3,
+                                                    description="the GNSS position's std the filter assumes, N, E, D")
+    gnss_velocity_std_mps: list[StdDeviation] = Field([50.0, 50.0, 70.0], min_length=3, max_length=3,
+                                                      description="the GNSS velocity's std the filter assumes, N, E, D")
+    barometer: bool = Field(False, description="the barometric height update")
+    # GNC.md's MS5803-class 50 Pa per sample over ρ·g: 4.2 m at sea level, 4.8 m at Lynx's 1.4 km pads (the thesis
+    # has no barometer update)
+    altitude_std_m: StdDeviation = Field(5.0, description="the barometric height's std")
+    initial_position_std_m: StdDeviation = Field(1.0, description="initial position std per axis (P0)")
+    initial_velocity_std_mps: StdDeviation = Field(1.0, description="initial velocity std per axis (P0)")
+    gnss_gate: Gate = Field(None, description="the GNSS update's χ² innovation gate (none: off)")
+    altitude_gate: Gate = Field(None, description="the barometer update's χ² innovation gate (none: off)")
 
 
 class FiltersConfig(_Strict):
@@ -665,8 +668,8 @@ class FiltersConfig(_Strict):
     azimuth ("rail") or from the mean of ``pad_samples`` accelerometer and magnetometer samples on the pad (TRIAD,
     "pad": the motor must light after them, ``rocket.motor.ignition_delay_s``); their tunings."""
 
-    initialisation: Literal["rail", "pad"] = "rail"
-    pad_samples: int = Field(500, ge=1, le=100_000)
+    initialisation: Literal["rail", "pad"] = Field("rail", description="the rail's attitude, or TRIAD on the pad")
+    pad_samples: int = Field(500, ge=1, le=100_000, description="GNC ticks on the pad averaged for TRIAD (\"pad\")")
     attitude: AttitudeFilterConfig = AttitudeFilterConfig()
     position: PositionFilterConfig = PositionFilterConfig()
 
