@@ -46,8 +46,8 @@ MODELS = ("simplified", "interpolated")
 PRECISIONS = ("float64", "float32")
 LOOP_FLIGHTS = 8
 """Single flights per timed loop (lynx_nominal: ~0.05–0.1 s each on the 2-core machine)."""
-QUEUE_PER_LANE = 8
-"""Flights per lane in the timed batch: 1024 on 2 cores, about the default chunk (1000)."""
+QUEUE_PER_LANE = 4
+"""Flights per lane in the timed batch: 1024 on 2 cores (512 on the costs' one), about the default chunk (1000)."""
 
 
 # --- measurements (in the measuring process) -----------------------------------------------------

@@ -57,10 +57,12 @@ def realization(campaign: Campaign, settings: SimSettings, master_key, index):
 LANES = 8
 """Flights per SIMD vector: 8 float64 in an AVX-512 register (a multiple of the 4 of AVX2)."""
 
-GROUP = 64
+GROUP = 128
 """Flights flown side by side (vmapped lanes) on each device; a lane whose flight is done takes the
-device's next one (``simulate_queue``). Measured on lynx_nominal, 2 cores: 32 lanes were slower
-overall, and since the RK4 loop 128 or 256 lanes are within noise of 64 (docs/performance.md)."""
+device's next one (``simulate_queue``). Measured on the 2-core machine, whole 1000-flight chunks
+(``bench.throughput``, two runs each): 128 lanes fly 6-7 % more flights/s than 64 on lynx_nominal
+(545-550 against 515-522) and 6-12 % more with the full GNC (lynx_nominal_gnc_1s: 524-548 against
+491-494); a kernel's fixed cost is spread over twice the lanes (docs/performance.md)."""
 
 
 def batch_size(chunk_size: int) -> int:
