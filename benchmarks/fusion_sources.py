@@ -1,15 +1,15 @@
 """Which source lines XLA's fused kernels compute, and how many times: duplicated arithmetic, found.
 
-    python benchmarks/fusion_sources.py [--campaign campaigns/lynx_nominal_gnc_1s.toml] [--lanes 64]
+    python benchmarks/fusion_sources.py [--campaign campaigns/lynx_nominal_gnc_1s.toml] [--lanes N]
         [--by function|line] [--top 30]
 
-Compiles one ``fly_block`` of ``--lanes`` vmapped flights (simplified model) and reads its optimised HLO back
-(the period loop's body and what runs once a block, the flights' parameters drawn from their keys):
-the number of kernels and of fused operations, then the source functions (or lines) of the fused operations,
-each with its operation count and the number of kernels it appears in. XLA's CPU fusion copies an elementwise
-producer into each consumer, so a function whose operations appear in tens of kernels is computed tens of times
-a period (docs/performance.md, "The full GNC"). Operations are attributed to their innermost frame in rocketmc's
-own code (``?``: none, e.g. JAX's internals).
+Compiles one ``fly_block`` of ``--lanes`` vmapped flights (default ``runner.GROUP``, as campaigns fly; simplified
+model) and reads its optimised HLO back (the period loop's body and what runs once a block, the flights' parameters
+drawn from their keys): the number of kernels and of fused operations, then the source functions (or lines) of the
+fused operations, each with its operation count and the number of kernels it appears in. XLA's CPU fusion copies an
+elementwise producer into each consumer, so a function whose operations appear in tens of kernels is computed tens
+of times a period (docs/performance.md, "The full GNC"). Operations are attributed to their innermost frame in
+rocketmc's own code (``?``: none, e.g. JAX's internals).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import jax.numpy as jnp  # noqa: E402
 from kernel_profile import computations, fused_sizes, fusion_calls  # noqa: E402
 
 from rocketmc.campaign import load_campaign  # noqa: E402
-from rocketmc.campaign.runner import realization_params, sim_settings  # noqa: E402
+from rocketmc.campaign.runner import GROUP, realization_params, sim_settings  # noqa: E402
 from rocketmc.sim import flight  # noqa: E402
 
 
@@ -79,7 +79,7 @@ def attribution(hlo: str, by_line: bool) -> tuple[collections.Counter, dict[str,
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--campaign", default="campaigns/lynx_nominal_gnc_1s.toml")
-    parser.add_argument("--lanes", type=int, default=64)
+    parser.add_argument("--lanes", type=int, default=GROUP)
     parser.add_argument("--by", choices=("function", "line"), default="function")
     parser.add_argument("--top", type=int, default=30)
     args = parser.parse_args()
