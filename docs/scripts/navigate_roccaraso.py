@@ -41,7 +41,9 @@ from rocketmc.analysis import replay
 from rocketmc.analysis.flight_log import ROCCARASO_2021, load_roccaraso_2021, read_pitot_static, reduce_flight
 from rocketmc.analysis.sensor_log import high_frequency_noise, read_sensor_log
 from rocketmc.campaign import load_campaign
+from rocketmc.campaign.config import PositionFilterConfig
 from rocketmc.campaign.model import filter_params
+from rocketmc.env.atmosphere import pressure_height_m
 from rocketmc.math import Vec3
 
 ROOT = Path(__file__).parents[2]
@@ -63,14 +65,24 @@ TUNINGS = {
 }  # fmt: skip
 """Label → ``replay.retuned``'s knobs over the thesis's tuning (GNSS on every axis but altitude, 500 m and 50 m/s
 from 10.5 s, field direction σ_b 2); σ_b 200: the magnetometer all but ignored, the gyroscope trusted."""
-AS_FLOWN_KNOBS = {"barometer": True, "gnss": "all", "gnss_after_s": 0.0, "gnss_std": GNSS_STD,
-                  "field_direction_std": 1e4}  # fmt: skip
-"""The as-flown tuning's [gnc.filters] knobs through ``replay.retuned``: the barometer (MS5803) on at the schema's
-5 m; the NEO-M9N's fixes from liftoff (it had 16 satellites on the pad) on every axis the log holds (its down
-velocity too: Skyward's avionics used north and east only for the GNSS's poor altitude, which the log lacks) at
-GNSS_STD; the magnetometer all but ignored (σ_b 1e4): its field reads 25 µT where the model has 45 µT, its dip 65°
-against the model dipole's 60.7° (whose declination is 16° off IGRF-13's), and a sphere fit of the flight's
-samples puts a ~2 µT hard-iron offset on it, so its direction is 5-10° off and the MEKF would follow that."""
+NAS_BAROMETER_R_PA2 = 4.37
+"""Skyward's NAS (2021) barometer update: a static pressure measurement through the ISA with R = 4.37 Pa²
+(../shared/GNC.md §3; boardcore's ``NAS::correctBaro`` innovates in pascals)."""
+PAD_PRESSURE_PA = 85_690.0  # the MS5803's, as the replay takes it (printed by ``main``)
+AS_FLOWN_ALTITUDE_STD_M = float(pressure_height_m(PAD_PRESSURE_PA - math.sqrt(NAS_BAROMETER_R_PA2), PAD_PRESSURE_PA))
+"""The NAS's barometer σ as a height [m] at the pad (√4.37 Pa over ρg there: 0.20 m; 0.23 m at apogee, the air
+thinner): the filters update with the barometric height, in metres."""
+BAROMETER_STD_SWEEP_M = (0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0)  # the as-flown pitot-static run's, printed
+SCHEMA_ALTITUDE_STD_M = PositionFilterConfig.model_fields["altitude_std_m"].default  # [m]: the thesis's part's 50 Pa
+AS_FLOWN_KNOBS = {"barometer": True, "barometer_std": AS_FLOWN_ALTITUDE_STD_M, "gnss": "all", "gnss_after_s": 0.0,
+                  "gnss_std": GNSS_STD, "field_direction_std": 1e4}  # fmt: skip
+"""The as-flown tuning's [gnc.filters] knobs through ``replay.retuned``: the barometer (MS5803) on, at the NAS's
+σ (``AS_FLOWN_ALTITUDE_STD_M``); the NEO-M9N's fixes from liftoff (it had 16 satellites on the pad) on every axis
+the log holds (its down velocity too: Skyward's avionics used north and east only for the GNSS's poor altitude,
+which the log lacks) at GNSS_STD; the magnetometer all but ignored (σ_b 1e4): its field reads 25 µT where the model
+has 45 µT, its dip 65° against the model dipole's 60.7° (whose declination is 16° off IGRF-13's), and a sphere fit of
+the flight's samples puts a ~2 µT hard-iron offset on it, so its direction is 5-10° off and the MEKF would follow
+that."""
 AS_FLOWN_ATTITUDE = {
     "gyro_noise": math.radians(0.1),  # σ_v [rad/s/√s]: the BMX160's 0.007 °/s/√Hz, ×15 for vibration, scale factor
     "bias_walk": math.radians(0.01),  # σ_u [rad/s²/√s]: its bias stays within 0.2 °/s over the flight (landed mean)
@@ -177,9 +189,13 @@ def main() -> None:
     runs["as flown, barometer off, GNSS horizontal"] = replay.replay(log, replay.retuned(horizontal, barometer=False),
                                                                      q_log, site)  # fmt: skip
     runs["as flown, pitot static"] = replay.replay(pitot_log, as_flown(params), q_log, site)
+    runs[f"as flown, pitot static, barometer σ {SCHEMA_ALTITUDE_STD_M:g} m"] = replay.replay(
+        pitot_log, replay.retuned(as_flown(params), barometer_std=SCHEMA_ALTITUDE_STD_M), q_log, site)  # fmt: skip
     runs["as flown, pitot static, GNSS horizontal"] = replay.replay(pitot_log, horizontal, q_log, site)
     runs[f"as flown, pitot static, GNSS horizontal, lock-out above Mach {LOCKOUT_MACH:g}"] = replay.replay(
         pitot_log, horizontal, q_log, site, barometer_max_mach=LOCKOUT_MACH)  # fmt: skip
+    sweep = {std: replay.replay(pitot_log, replay.retuned(as_flown(params), barometer_std=std), q_log, site)
+             for std in BAROMETER_STD_SWEEP_M}  # fmt: skip
     first = runs[next(iter(runs))]
     windows = replay.flight_windows(first, log)
     windows["coast from 5 s"] = (REFERENCES_SETTLED_S, windows["coast"][1])
@@ -190,6 +206,11 @@ def main() -> None:
           f"(flight_log.reduce_flight: burnout {events.burnout_time_s:.2f}, apogee {events.apogee_time_s:.2f}, landing "
           f"shock {events.landing_time_s:.2f}); pad pressures: MS5803 {pads['MS5803']:.1f} Pa, pitot static "
           f"{pads['pitot static']:.1f} Pa")  # fmt: skip
+    print("as flown, pitot static, by the barometer's σ [m]: height − pitot static RMS, coast / descent [m], "
+          "flight-path angle − GNSS RMS, coast [deg]: " + "; ".join(
+              f"{std:g} {m['height_rms_coast_m']:.2f} / {m['height_rms_descent_m']:.2f}, {m['gamma_rms_coast_deg']:.2f}"
+              for std, m in ((std, replay.navigation_metrics(nav, pitot_log, windows, pads["pitot static"]))
+                             for std, nav in sweep.items())))  # fmt: skip
     metrics = {}
     for label, nav in runs.items():
         metrics[label] = replay.navigation_metrics(nav, log, windows, pads["MS5803"])

@@ -414,7 +414,7 @@ def _navigate(args) -> int:
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     params = nav_replay.retuned(filter_params(campaign), None if args.barometer is None else args.barometer == "on",
                                 args.gnss, args.gnss_after, args.gnss_std, args.field_direction_std,
-                                None if args.gates is None else args.gates == "on")  # fmt: skip
+                                None if args.gates is None else args.gates == "on", args.barometer_std)  # fmt: skip
     launch, site = config.launch, config.site
     say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     say(f"{args.log_dir}: {len(log['imu'])} IMU ticks, {len(log['baro'])} barometer and {len(log['gnss'])} GNSS "
@@ -432,7 +432,8 @@ def _navigate(args) -> int:
     top = int(nav["height_m"].idxmax())
     gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
     print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
-          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'} ({args.static_source}"
+          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'} ({args.static_source}, "
+          f"σ {float(params.position.altitude_std):g} m"
           + ("" if args.barometer_max_mach is None else f", locked out above Mach {args.barometer_max_mach:g}")
           + f"), field direction σ "
           f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): " + ", ".join(
@@ -668,6 +669,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="the static pressure of the barometer's samples (the update and the barometric height "
                                "compared with): the log's barometer, or the static port of its pitot_42hz.csv (the "
                                "real log's) (default: baro)")  # fmt: skip
+    navigate.add_argument("--barometer-std", type=float, metavar="M",
+                          help="the barometric height's standard deviation [m] (default: the campaign's)")
     navigate.add_argument("--barometer-max-mach", type=float, metavar="M",
                           help="lock the barometer out while the filters' estimated speed exceeds Mach M "
                                "(default: never)")  # fmt: skip
@@ -750,9 +753,10 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
                      f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
     if args.command == "navigate":
-        spreads = [*(args.gnss_std or ()), *(() if args.field_direction_std is None else (args.field_direction_std,))]
+        spreads = [*(args.gnss_std or ()), *(v for v in (args.field_direction_std, args.barometer_std) if v is not None)]
         if not all(0 < v < float("inf") for v in spreads) or not 0 <= (args.gnss_after or 0.0) < float("inf"):
-            parser.error("--gnss-std and --field-direction-std must be positive, --gnss-after at least 0")
+            parser.error("--gnss-std, --field-direction-std and --barometer-std must be positive, --gnss-after at "
+                         "least 0")
         if args.barometer_max_mach is not None and not 0 < args.barometer_max_mach < float("inf"):
             parser.error("--barometer-max-mach must be a positive Mach number")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,

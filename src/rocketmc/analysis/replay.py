@@ -441,13 +441,16 @@ def accelerometer_attitude(log: Mapping[str, pd.DataFrame], azimuth_deg: float) 
 
 def retuned(params: FilterParams, barometer: bool | None = None, gnss: str | None = None,
             gnss_after_s: float | None = None, gnss_std: tuple[float, float] | None = None,
-            field_direction_std: float | None = None, gates: bool | None = None) -> FilterParams:  # fmt: skip
+            field_direction_std: float | None = None, gates: bool | None = None,
+            barometer_std: float | None = None) -> FilterParams:  # fmt: skip
     """``params`` with the knobs of ``rocketmc navigate`` replaced where given (the fields of ``[gnc.filters]``):
     the barometric height update; the GNSS's axes ("all" or "horizontal"), the time from which its fixes are used
     [s since liftoff] and its standard deviations (position [m], velocity [m/s], the same on every axis); the
     magnetometer's field direction standard deviation [-]; gates False: every innovation gate off (True: the
-    campaign's)."""
+    campaign's); the barometric height's standard deviation [m]."""
     position, attitude = params.position, params.attitude
+    if barometer_std is not None:
+        position = dataclasses.replace(position, altitude_std=jnp.asarray(float(barometer_std)))
     if gnss_std is not None:
         position = dataclasses.replace(position, gnss_position_std=Vec3(*(jnp.asarray(float(gnss_std[0])),) * 3),
                                        gnss_velocity_std=Vec3(*(jnp.asarray(float(gnss_std[1])),) * 3))  # fmt: skip
