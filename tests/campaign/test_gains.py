@@ -101,6 +101,14 @@ def test_without_gnc_nothing_is_designed():
     assert campaign.config.gnc is None and campaign.gnc_schedule is None
 
 
+def test_controller_and_sensors_added_at_once():
+    """``with_overrides(controller=True, sensors=True)`` on a campaign with neither: the default [gnc] (its
+    navigation the schema's "truth" until the sensors come) flies on raw sensors, designed."""
+    campaign = campaign_from_dict(NOMINAL, CAMPAIGNS).with_overrides(controller=True, sensors=True)
+    assert campaign.config.gnc.navigation == "sensors" and campaign.config.avionics is not None
+    assert campaign.gnc_schedule is not None
+
+
 def shifted_rate_jacobian(raw: dict, speed: float, height: float):
     """(A rows v, w, p, q, r of the plant the campaign designs from, the same rows by central differences
     of the flight's own right-hand side ``sim.flight.derivatives``) at axial speed [m/s] and height above

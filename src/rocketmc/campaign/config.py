@@ -970,7 +970,8 @@ class Campaign:
                 data[section] = {} if on else None
                 data["dispersions"] = {k: d for k, d in data["dispersions"].items() if on or not k.startswith(section + ".")}
         if sensors is not None and data["gnc"] is not None:
-            kept = data["gnc"]["navigation"] if data["gnc"]["navigation"] != "truth" else "sensors"
+            current = data["gnc"].get("navigation", "truth")  # a [gnc] just added is empty: the schema's default
+            kept = current if current != "truth" else "sensors"
             data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
         config = _validate(data)
         config = _with_sensor_spreads(config)
