@@ -367,8 +367,9 @@ def control_step(
     """One control period of ``period`` [s] (``control_period``) with the turbulent gust held: RK4 substeps
     of the rigid body with events, then the turbulence filters advanced over the period with ``noise``,
     the period's row of turbulence noise (None without turbulence); ``tick`` + 1. Returns the new state and,
-    with ``first_stage``, the CG's acceleration [m/s², NED], the body's angular acceleration [rad/s², FRD] and
-    the dynamic pressure [Pa] at the period start (the first RK4 stage's), as one (7,) array, else None.
+    with ``first_stage``, the CG's acceleration [m/s², NED], the body's angular acceleration [rad/s², FRD], the
+    dynamic pressure [Pa] and the CG's position x [m, body] at the period start (the first RK4 stage's), as one
+    (8,) array, else None.
 
     deflections: the canard deflections δ1..δn [rad] as a function of the time t [s] inside the
     period (held, or the servos' response evaluated at each RK4 stage).
@@ -379,9 +380,12 @@ def control_step(
 
     def rhs(t, y, events):
         d_body, diag = derivatives(t, y, p, deflections(t), gust, events)
-        # one array, not a pytree: RK4 keeps its first stage's by-products with a select per leaf and stage
-        extra = jnp.stack([*d_body.v_n, *d_body.omega_b, diag.qbar]) if first_stage else None
-        return d_body, (diag, extra)
+        if not first_stage:
+            return d_body, (diag, None)
+        # one array, not a pytree: RK4 keeps its first stage's by-products with a select per leaf and stage; the CG
+        # is the stage's own (``loads``'): the same operations at the same time, computed once by XLA
+        cg_x = mass_properties(p, t).cg_x
+        return d_body, (diag, jnp.stack([*d_body.v_n, *d_body.omega_b, diag.qbar, cg_x]))
 
     def substep(carry, _):
         t0, body0, events, _ = carry
@@ -489,15 +493,15 @@ def _sensed(p: FlightParams, state: FlightState, deflections, sensing, noise: St
 def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, first, sensing,
                    noise: StepNoise) -> FlightState:  # fmt: skip
     """``state``, the period's end, with the accelerometer's sample of the period start ``start`` (from the
-    accelerations and dynamic pressure ``first`` there, ``control_step``'s, at rest once landed); ``state`` itself
-    without sensors."""
+    accelerations, dynamic pressure and CG ``first`` there, ``control_step``'s, at rest once landed); ``state``
+    itself without sensors."""
     if p.avionics is None:
         return state
-    acceleration_n, omega_dot_b, qbar = Vec3(*first[:3]), Vec3(*first[3:6]), first[6]
+    acceleration_n, omega_dot_b, qbar, cg_x = Vec3(*first[:3]), Vec3(*first[3:6]), first[6], first[7]
     body, landed = _at_rest_once_landed(start), done(start)
     zero = Vec3.zeros(start.t)
     position = p.avionics.accelerometer.position_b
-    arm_b = Vec3(position[0] - mass_properties(p, start.t).cg_x, position[1], position[2])
+    arm_b = Vec3(position[0] - cg_x, position[1], position[2])
     force = specific_force_b(tree_where(landed, zero, acceleration_n), body.q_nb, body.omega_b,
                              tree_where(landed, zero, omega_dot_b), arm_b)  # fmt: skip
     qbar = jnp.where(landed, 0.0, qbar)
