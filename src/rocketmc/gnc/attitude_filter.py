@@ -44,6 +44,7 @@ import operator
 
 import jax.numpy as jnp
 
+from ..math.fusion import computed_once
 from ..math.vectors import Quat, Vec3
 from ..pytree import pytree_dataclass
 
@@ -171,7 +172,7 @@ def _coefficients(x2):
             acc = c + x2 * acc
         out.append(acc)
     x = jnp.sqrt(jnp.where(series, 1.0, x2))  # never 0 in the closed branch (finite gradients)
-    s, c = jnp.sin(x), jnp.cos(x)
+    s, c = computed_once(jnp.stack([jnp.sin(x), jnp.cos(x)]))  # read by ~50 kernels
     closed = (
         s / x,
         (1.0 - c) / x**2,
@@ -212,8 +213,9 @@ def rotation_step(omega_b: Vec3, dt) -> Quat:
     """The quaternion of a rotation at constant body rates ω [rad/s] over dt [s]: (cos(θ/2), sin(θ/2)·ω/|ω|),
     θ = |ω|·dt (exact for constant rates; smooth at ω = 0)."""
     angle = omega_b.norm() * dt
-    half_sinc = 0.5 * dt * jnp.sinc(0.5 * angle / jnp.pi)  # sin(θ/2)/|ω|
-    return Quat(jnp.cos(0.5 * angle), omega_b.x * half_sinc, omega_b.y * half_sinc, omega_b.z * half_sinc)
+    half_cos, half_sinc = computed_once(jnp.stack([jnp.cos(0.5 * angle), jnp.sinc(0.5 * angle / jnp.pi)]))
+    half_sinc = 0.5 * dt * half_sinc  # sin(θ/2)/|ω|
+    return Quat(half_cos, omega_b.x * half_sinc, omega_b.y * half_sinc, omega_b.z * half_sinc)
 
 
 def initial_attitude(q_nb0: Quat, tuning: AttitudeTuning) -> AttitudeEstimate:

@@ -21,6 +21,7 @@ from jax.extend.random import threefry2x32_p
 
 from ..env.atmosphere import G0
 from ..math import Quat, Vec3
+from ..math.fusion import computed_once
 from ..pytree import pytree_dataclass, static_field
 from .errors import Channel, ChannelState, initial_channel, sample
 from .parts import SENSORS
@@ -260,7 +261,7 @@ def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_n
     if not gnss.channel.ideal:  # the slow sinusoidal position bias and its derivative, an error of the receiver
         omega = 2.0 * jnp.pi * gnss.frequency
         # sin and cos of ωt + φ by the angle sum: two transcendentals a tick instead of six (φ's are the flight's)
-        sin_wt, cos_wt = jnp.sin(omega * t), jnp.cos(omega * t)
+        sin_wt, cos_wt = computed_once(jnp.stack([jnp.sin(omega * t), jnp.cos(omega * t)]))
         sin_phase = sin_wt * jnp.cos(gnss.phase) + cos_wt * jnp.sin(gnss.phase)
         cos_phase = cos_wt * jnp.cos(gnss.phase) - sin_wt * jnp.sin(gnss.phase)
         fix = fix + jnp.concatenate([gnss.amplitude * sin_phase, gnss.amplitude * omega * cos_phase])
