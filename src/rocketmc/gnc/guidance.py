@@ -14,7 +14,6 @@ import math
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0
-from ..math.fusion import computed_once
 from ..math.vectors import Quat, Vec3
 from ..pytree import pytree_dataclass
 
@@ -78,8 +77,8 @@ def reference_direction(params: GuidanceParams, nav: Navigation, t) -> Vec3:
     c1 = jnp.sqrt(2.0 * G0 * params.apogee_m)
     v_x = c1 / jnp.tan(params.flight_path_angle_rad)
     gamma = jnp.arctan((c1 - G0 * (t - params.t0_s)) / v_x)
-    cg, sg = computed_once(jnp.stack([jnp.cos(gamma), jnp.sin(gamma)]))
-    return Vec3(jnp.cos(params.heading_rad) * cg, jnp.sin(params.heading_rad) * cg, -sg)
+    cg = jnp.cos(gamma)
+    return Vec3(jnp.cos(params.heading_rad) * cg, jnp.sin(params.heading_rad) * cg, -jnp.sin(gamma))
 
 
 def _clip_norm2(y, z, limit):
