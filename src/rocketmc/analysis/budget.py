@@ -327,7 +327,7 @@ def plot_budget(summary: dict, path: str | Path | None = None):
     flown = [r for r in summary["rows"] if r["flown"] and r["ellipse"] is not None]
     bars = [r for r in flown if r["kind"] != "reference"]
     colors = {"campaign": "tab:blue", "none": "tab:green", "source": "tab:orange"}
-    fig = Figure(figsize=(max(6.0, 1.0 + 0.9 * len(bars)), 4.5), layout="constrained")
+    fig = Figure(figsize=(max(7.0, 1.5 + 1.3 * len(bars)), 4.5), layout="constrained")
     ax = fig.add_subplot()
     areas_km2 = [r["ellipse"]["area_m2"] / 1e6 for r in flown]
     if max(areas_km2) > LOG_SCALE_SPAN * min(areas_km2):
