@@ -238,10 +238,10 @@ def summarize_budget(campaign: Campaign, rows: Sequence[Row]) -> dict:
         if row.outputs is not None:
             o = row.outputs
             landed = _landed(o)
-            ellipse = confidence_ellipse(o["impact_north_m"][landed], o["impact_east_m"][landed], LEVEL) if landed.sum() >= 3 else None  # fmt: skip
+            north, east = o["impact_north_m"][landed], o["impact_east_m"][landed]
             entry.update({
                 "n": int(o["status"].size), "failed": int((o["status"] != 0).sum()), "n_landed": int(landed.sum()),
-                "ellipse": None if ellipse is None else ellipse.to_dict(),
+                "ellipse": confidence_ellipse(north, east, LEVEL).to_dict() if north.size >= 3 else None,
                 "ratios": {base: None if outputs.get(base) is None or base == row.name else _ratio(o, outputs[base])
                            for base in RATIO_BASES},
                 "metrics": {name: _percentiles(o[name]) for name in (*NAVIGATION_METRICS, *CONTROL_METRICS) if name in o},
