@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from rocketmc.analysis.budget import SOURCES, BudgetError, budget, budget_rows, format_budget
-from rocketmc.campaign import campaign_from_dict, load_campaign, runner
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, runner
 from rocketmc.campaign.runner import run_chunks
 from rocketmc.cli import main
 
@@ -138,3 +138,15 @@ def test_idle_sources_without_flying(campaign):
     assert [name for name, row in rows.items() if row.campaign is not None] == ["all", "none"]
     with pytest.raises(BudgetError, match="unknown source"):
         budget_rows(campaign, ["compass"])
+
+
+def test_values_override(campaign):
+    """``Campaign.with_overrides(values=...)``, the budget's builder: a field set by dotted path and validated; a
+    path through nothing, or to an unknown key, refused in one line."""
+    changed = campaign.with_overrides(values={"avionics.gnss.truth_only": True, "avionics.gyroscope.bias.0": 0.5})
+    assert changed.config.avionics.gnss.truth_only and changed.config.avionics.gyroscope.bias[0] == 0.5
+    assert not campaign.config.avionics.gnss.truth_only and changed.gnc_schedule is campaign.gnc_schedule
+    with pytest.raises(ConfigError, match=r"^rocket\.nothing\.x: not a field of this campaign$"):
+        campaign.with_overrides(values={"rocket.nothing.x": 1.0})
+    with pytest.raises(ConfigError, match=r"avionics\.gnss\.truth_onl: unknown key"):
+        campaign.with_overrides(values={"avionics.gnss.truth_onl": True})

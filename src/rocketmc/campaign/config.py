@@ -977,7 +977,10 @@ class Campaign:
             kept = current if current != "truth" else "sensors"
             data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
         for path, value in (values or {}).items():
-            data = _set_path(data, path, value)
+            try:
+                data = _set_path(data, path, value)
+            except (KeyError, IndexError, TypeError, ValueError):
+                raise ConfigError(f"{path}: not a field of this campaign") from None
         config = _validate(data)
         config = _with_sensor_spreads(config)
         campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
