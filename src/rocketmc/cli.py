@@ -2,7 +2,7 @@
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
 a campaign, ``sensors simulate``: one realization's sensor log, ``navigate``: the navigation filters replayed on
 a sensor log, ``fly``: one flight's time series, ``validate`` the simulation against a real flight, ``bench`` this
-machine."""
+machine, ``budget``: the GNC error budget of a closed-loop campaign."""
 
 from __future__ import annotations
 
@@ -540,6 +540,33 @@ def _validate(args) -> int:
     return 0 if all(c.passed is not False for c in checks) else 1
 
 
+def _budget(args) -> int:
+    from .analysis.budget import BudgetError, budget_rows, fly_rows, format_budget, plot_budget, summarize_budget
+
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model)
+    sources = None if args.sources is None else [name for name in args.sources.split(",") if name]
+    try:
+        rows = budget_rows(campaign, sources)
+    except BudgetError as e:
+        raise RocketmcError(f"{args.campaign}: {e}") from None
+    cfg = campaign.config
+
+    def log(message):
+        if not args.quiet:
+            print(message, file=sys.stderr, flush=True)
+
+    flown = sum(row.campaign is not None for row in rows)
+    log(f"{cfg.name}: error budget, {flown} rows of {cfg.n_realizations} realizations, seed {cfg.seed} (one "
+        "compilation per row)")  # fmt: skip
+    summary = summarize_budget(campaign, fly_rows(rows, log))
+    print(json.dumps(summary, indent=2, allow_nan=False) if args.json else format_budget(summary))
+    if plot:
+        plot_budget(summary, plot)
+        print(f"wrote {plot}", file=sys.stderr)
+    return 0
+
+
 def _bench(args) -> int:
     from .bench import DEFAULT_CAMPAIGN, BenchError, format_report, run_benchmarks
     from .campaign import ConfigError
@@ -705,6 +732,25 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--plot-dir", "--plot", dest="plot_dir", metavar="DIR",
                           help="folder for the overlay plots (roccaraso-2021; --plot: its old spelling)")  # fmt: skip
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    budget = commands.add_parser(
+        "budget", help="the GNC error budget: a closed-loop campaign flown with each navigation error source alone",
+        description="Fly a closed-loop campaign (navigation 'filters' or 'sensors') with each navigation error source "
+        "alone, with all (the campaign), with none (the navigation on perfect sensors), on perfect navigation and "
+        "with the controller off, every row with the same seed and N (the same winds and draws): the 95 %% landing "
+        "ellipse of each row, its paired ratios to the others, the navigation and control errors and the failed "
+        "flights. One compilation per row flown; no result file.",
+    )  # fmt: skip
+    budget.add_argument("campaign", help="campaign file (TOML) with [gnc] navigation 'filters' or 'sensors'")
+    budget.add_argument("-n", type=int, help="number of realizations (overrides the campaign)")
+    budget.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
+    budget.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
+                        help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    budget.add_argument("--sources", metavar="NAME,...",
+                        help="the error sources flown alone, separated by commas (default: all of them: "
+                             "accelerometer, gyroscope, magnetometer, barometer, gnss, canard_feedback)")  # fmt: skip
+    budget.add_argument("--json", action="store_true", help="print the budget as JSON")
+    budget.add_argument("--plot", help="write a bar chart of each row's ellipse area to this PNG")
+    budget.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     bench = commands.add_parser(
         "bench", help="measure this machine: flights/s, compile time, peak memory, float32 against float64",
         description="Fly a campaign for each N, aerodynamic model and precision, each in a fresh process: "
@@ -760,7 +806,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.barometer_max_mach is not None and not 0 < args.barometer_max_mach < float("inf"):
             parser.error("--barometer-max-mach must be a positive Mach number")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
-               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench}  # fmt: skip
+               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

@@ -11,6 +11,7 @@ import dataclasses
 import hashlib
 import math
 import tomllib
+from collections.abc import Mapping
 from datetime import datetime, timezone
 from importlib import resources
 from pathlib import Path
@@ -952,13 +953,15 @@ class Campaign:
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
         controller: bool | None = None, sensors: bool | None = None, navigation: str | None = None,
+        values: Mapping[str, object] | None = None,
     ) -> Campaign:  # fmt: skip
         """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
         True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
         (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
         (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
         campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
-        perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match."""
+        perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
+        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above."""
         if navigation is not None:
             sensors = navigation != "truth"
         data = self.config.model_dump()
@@ -973,6 +976,11 @@ class Campaign:
             current = data["gnc"].get("navigation", "truth")  # a [gnc] just added is empty: the schema's default
             kept = current if current != "truth" else "sensors"
             data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
+        for path, value in (values or {}).items():
+            try:
+                data = _set_path(data, path, value)
+            except (KeyError, IndexError, TypeError, ValueError):
+                raise ConfigError(f"{path}: not a field of this campaign") from None
         config = _validate(data)
         config = _with_sensor_spreads(config)
         campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
