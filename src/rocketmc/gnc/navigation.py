@@ -19,6 +19,7 @@ import dataclasses
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0, pressure_height_m
+from ..env.magnetic import first_order_field
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass, static_field, tree_where
 from ..sensors.avionics import Avionics, Bus, to_body
@@ -82,8 +83,8 @@ def liftoff_sensed(av: Avionics, bus: Bus):
 class FilterParams:
     """The navigation filters of one flight. attitude, position: their tunings; field_n (3,): the geomagnetic
     model's field at the pad [T, NED] and field_gradient (3, 3) its derivative along r_n [T/m] (the reference
-    field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
-    ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
+    field direction at the estimated position, to first order: the second-order term over ±10 km across and 10 km
+    up is ~3e-6 of the dipole's field, ≤ 1.4 nT (3e-5) of the IGRF's); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
     the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD (0:
     from the rail; static); horizontal_only: GNSS updates of north and east only (static); barometer: the
     barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
@@ -164,8 +165,7 @@ def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterStat
 
 def _reference_field(params: FilterParams, r_n: Vec3) -> Vec3:
     """The model's geomagnetic field at ``r_n`` [T, NED], to first order from the pad's."""
-    g, r = params.field_gradient, (r_n.x, r_n.y, r_n.z)
-    return Vec3(*(params.field_n[i] + sum(g[i, j] * r[j] for j in range(3)) for i in range(3)))
+    return first_order_field(params.field_n, params.field_gradient, r_n)
 
 
 def innovation_gate(gate: float | None, nis) -> jnp.ndarray:
