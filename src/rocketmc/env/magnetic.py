@@ -182,16 +182,19 @@ def geodetic_to_ecef_m(latitude_rad, longitude_rad, height_m):
 
 @functools.lru_cache(maxsize=16)
 def igrf_site_field_gradient(latitude_deg, longitude_deg, altitude_m, date: datetime.date, table: str = IGRF14_TABLE):
-    """(the IGRF-14 field (or ``table``'s) [T] at a site given in degrees at 0 h UTC of ``date``, its derivative along an offset from
-    there [T/m] (3, 3)), both in the site's NED axes (geodetic: down along the ellipsoid's normal; the flat Earth's),
-    as numpy arrays: B = −∇V at the offset point, by automatic differentiation (the gradient is −V's Hessian:
-    symmetric and traceless). The altitude is taken above the ellipsoid (the geoid is within ~100 m of it: ~2 nT)."""
+    """(the IGRF-14 field (or ``table``'s) [T] at a site given in degrees at 0 h UTC of ``date``, its derivative along
+    an offset from there [T/m] (3, 3)), both in the site's NED axes (geodetic: down along the ellipsoid's normal; the
+    flat Earth's), as numpy arrays: B = −∇V at the offset point, by automatic differentiation (the gradient is −V's
+    Hessian: symmetric and traceless). The altitude is taken above the ellipsoid (the geoid is within ~100 m of it:
+    ~2 nT). Evaluated eagerly (~2 s; compiled, XLA takes minutes over the unrolled degree-13 sums) and cached."""
     with jax.ensure_compile_time_eval():  # the site's numbers: computed once on the host, even under jit
         coefficients = igrf_coefficients(date, table)
         lat, lon = np.radians(latitude_deg), np.radians(longitude_deg)
-        site = _ned_axes(lat, lon)
-        centre = geodetic_to_ecef_m(lat, lon, altitude_m)
-        field_t = lambda offset_n: -1e-9 * site @ jax.grad(_igrf_potential, argnums=1)(coefficients, centre + site.T @ offset_n)  # noqa: E731
+        site, centre = _ned_axes(lat, lon), geodetic_to_ecef_m(lat, lon, altitude_m)
+
+        def field_t(offset_n):
+            return -1e-9 * site @ jax.grad(_igrf_potential, argnums=1)(coefficients, centre + site.T @ offset_n)
+
         origin = jnp.zeros(3)
         return np.asarray(field_t(origin), dtype=float), np.asarray(jax.jacfwd(field_t)(origin), dtype=float)
 
