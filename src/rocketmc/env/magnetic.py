@@ -186,7 +186,8 @@ def igrf_site_field_gradient(latitude_deg, longitude_deg, altitude_m, date: date
     an offset from there [T/m] (3, 3)), both in the site's NED axes (geodetic: down along the ellipsoid's normal; the
     flat Earth's), as numpy arrays: B = −∇V at the offset point, by automatic differentiation (the gradient is −V's
     Hessian: symmetric and traceless). The altitude is taken above the ellipsoid (the geoid is within ~100 m of it:
-    ~2 nT). Evaluated eagerly (~2 s; compiled, XLA takes minutes over the unrolled degree-13 sums) and cached."""
+    ~2 nT). Evaluated eagerly (~2 s; compiled, XLA takes minutes over the unrolled degree-13 sums) and cached
+    (read-only arrays)."""
     with jax.ensure_compile_time_eval():  # the site's numbers: computed once on the host, even under jit
         coefficients = igrf_coefficients(date, table)
         lat, lon = np.radians(latitude_deg), np.radians(longitude_deg)
@@ -196,7 +197,10 @@ def igrf_site_field_gradient(latitude_deg, longitude_deg, altitude_m, date: date
             return -1e-9 * site @ jax.grad(_igrf_potential, argnums=1)(coefficients, centre + site.T @ offset_n)
 
         origin = jnp.zeros(3)
-        return np.asarray(field_t(origin), dtype=float), np.asarray(jax.jacfwd(field_t)(origin), dtype=float)
+        field, gradient = np.array(field_t(origin), dtype=float), np.array(jax.jacfwd(field_t)(origin), dtype=float)
+    for cached in (field, gradient):  # shared by every caller: read-only
+        cached.setflags(write=False)
+    return field, gradient
 
 
 def first_order_field(field_n, gradient, r_n: Vec3) -> Vec3:
