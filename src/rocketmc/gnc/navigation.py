@@ -83,8 +83,8 @@ def liftoff_sensed(av: Avionics, bus: Bus):
 class FilterParams:
     """The navigation filters of one flight. attitude, position: their tunings; field_n (3,): the geomagnetic
     model's field at the pad [T, NED] and field_gradient (3, 3) its derivative along r_n [T/m] (the reference
-    field direction at the estimated position, to first order: the second-order term over ±10 km across and 10 km
-    up is ~3e-6 of the dipole's field, ≤ 1.4 nT (3e-5) of the IGRF's); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
+    field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
+    ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
     the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD (0:
     from the rail; static); horizontal_only: GNSS updates of north and east only (static); barometer: the
     barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
