@@ -251,7 +251,7 @@ def igrf_points():
     rng = np.random.default_rng(11)
     points = [(*SITES["roccaraso"], LAUNCH_DAY), (*SITES["santa_margarida"], LAUNCH_DAY), (*THESIS_SITE, LAUNCH_DAY),
               (*THESIS_SITE, datetime.date(2030, 1, 1)), (*THESIS_SITE, datetime.date(1900, 1, 1))]  # fmt: skip
-    for _ in range(6):
+    for _ in range(4):
         day = datetime.date(1900, 1, 1) + datetime.timedelta(days=int(rng.integers(0, 47482)))
         points.append((math.degrees(math.asin(rng.uniform(-0.98, 0.98))), rng.uniform(-180.0, 180.0),
                        rng.uniform(-400.0, 30e3), day))  # fmt: skip
