@@ -19,6 +19,7 @@ import dataclasses
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0, pressure_height_m
+from ..env.magnetic import first_order_field
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass, static_field, tree_where
 from ..sensors.avionics import Avionics, Bus, to_body
@@ -164,8 +165,7 @@ def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterStat
 
 def _reference_field(params: FilterParams, r_n: Vec3) -> Vec3:
     """The model's geomagnetic field at ``r_n`` [T, NED], to first order from the pad's."""
-    g, r = params.field_gradient, (r_n.x, r_n.y, r_n.z)
-    return Vec3(*(params.field_n[i] + sum(g[i, j] * r[j] for j in range(3)) for i in range(3)))
+    return first_order_field(params.field_n, params.field_gradient, r_n)
 
 
 def innovation_gate(gate: float | None, nis) -> jnp.ndarray:
