@@ -30,7 +30,8 @@ def test_a_calibrated_part_changes_only_spreads_and_narrows_them(name):
     sensors = [key for key, value in raw.items() if isinstance(value, dict)]
     assert sensors == [key for key, value in calibrated.items() if isinstance(value, dict)]
     for sensor in sensors:
-        changed = {k for k in calibrated[sensor].keys() | raw[sensor].keys() if calibrated[sensor].get(k) != raw[sensor].get(k)}
+        ours, theirs = calibrated[sensor], raw[sensor]
+        changed = {k for k in ours.keys() | theirs.keys() if ours.get(k) != theirs.get(k)}
         assert changed <= CALIBRATION, (sensor, changed)
         assert all(c < r for c, r in zip(calibrated[sensor]["bias_std"], raw[sensor]["bias_std"])), sensor
 

@@ -1,7 +1,7 @@
 """Checks of a campaign before and after flying that warn rather than refuse: a nominal rocket that is
 statically unstable (someone may fly one on purpose, to see where it lands), navigation filters on an uncalibrated
-magnetometer or gyroscope, and flights beyond the range of the aerodynamic tables or of the method that built them. Each returns the warning lines (none: all is
-well), for ``run``, ``fly`` and ``report`` alike."""
+magnetometer or gyroscope, and flights beyond the range of the aerodynamic tables or of the method that built them.
+Each returns the warning lines (none: all is well), for ``run``, ``fly`` and ``report`` alike."""
 
 from __future__ import annotations
 

@@ -681,7 +681,7 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
     if state.gnc is not None:
         summary.update(control_summary(state.gnc))
     if p.gnc is not None and p.gnc.navigation == "filters":
-        summary.update(navigation_summary(state.gnc.navigation))
+        summary.update(navigation_summary(state.gnc.navigation, summary["burnout_speed_mps"]))
         failed = [state.gnc.navigation.failed]
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
