@@ -50,7 +50,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     from .analysis.ellipse import AreaConvergence
     from .analysis.flight_record import write_trajectories
     from .campaign import ResultWriter
-    from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings, stability_warnings
+    from .campaign.checks import VALIDITY_OUTPUTS, calibration_warnings, outputs_validity_warnings, stability_warnings
     from .campaign.runner import chunking
 
     cfg = campaign.config
@@ -65,7 +65,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     if writer.already_complete:
         print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
         return 0
-    warnings = stability_warnings(campaign)
+    warnings = stability_warnings(campaign) + calibration_warnings(campaign)
     _warn(warnings)
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
@@ -162,6 +162,7 @@ def _warn(lines: list[str]) -> None:
 
 def _report(args) -> int:
     from .analysis import format_summary, load_run, plot_impacts, summarize
+    from .analysis.results import navigation_warnings
     from .analysis.export import MAP_SUFFIXES, write_map
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
@@ -172,6 +173,7 @@ def _report(args) -> int:
         raise RocketmcError(f"--plot-dir {plots}: expected a folder, or a new one's name in an existing folder")
     run = load_run(args.file)
     summary = summarize(run)
+    _warn(navigation_warnings(run))
     from .analysis.safety import format_outside, outside_polygon, outside_radius, read_polygon
 
     if args.outside_radius is not None:
@@ -212,6 +214,7 @@ def _compare(args) -> int:
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     runs = [(file, load_run(file)) for file in args.files]
     comparison = compare(runs)
+    _warn(comparison["warnings"])
     print(json.dumps(comparison, indent=2, allow_nan=False) if args.json else format_comparison(comparison))
     if plot:
         plot_comparison(runs, path=plot)

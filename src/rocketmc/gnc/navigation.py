@@ -15,6 +15,7 @@ solution (the thesis fed the a-priori one forward, a tick late). Frames: NED fro
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import jax.numpy as jnp
 
@@ -303,14 +304,48 @@ def track_errors(state: FilterState, q_nb: Quat, r_n: Vec3, v_n: Vec3, bias_b: V
     return dataclasses.replace(state, errors=errors)
 
 
-def navigation_summary(state: FilterState) -> dict:
-    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came."""
+DIVERGED_ATTITUDE_RAD = 0.1745329251994330  # 10°
+"""A flight's navigation has diverged when its attitude estimate is further than this from the truth at some tick of
+the controller's active time: 5x the thesis filters' largest window error (median 1.82°, the headwind test's ascent
+4.05°, docs/validation.md); 10° of attitude error tilts the inertial acceleration by 17 % of the thrust's."""
+DIVERGED_VELOCITY_RAD = 0.03490658503988659  # 2°
+"""... or when its velocity error at burnout, over the speed then, exceeds this (an upper bound on the estimated
+flight path's direction error, which guidance steers by): above the controller's own tracking error on perfect
+navigation (χ 1.47° RMS, Lynx), 8x the thesis filters' median (0.25°, at most 0.55° in 128 flights) and above the
+largest of custom_canards' on a gyro-trusting tuning (1.5°), where its ellipse is 1.9x perfect navigation's
+(docs/navigation.md). A fraction, not m/s: the same attitude error makes a faster boost's velocity error larger."""
+DIVERGED_NEES = 60.0
+"""... or when either filter's NEES (6 degrees of freedom) averaged over the controller's active time exceeds this:
+10x its χ² mean of 6, the errors √10 ≈ 3.2 times the filter's own σ throughout the window, so its gates and gains
+trust an estimate that is wrong (the thesis's tuning averages 1e-4 and 0.22, a consistent tuning 6)."""
+
+DIVERGED_MEANING = (
+    f"1: the navigation estimate diverged (attitude error above {math.degrees(DIVERGED_ATTITUDE_RAD):g}° in the "
+    f"controller's active time, velocity error at burnout above {math.degrees(DIVERGED_VELOCITY_RAD):g}° of the speed "
+    f"then, or a filter's NEES averaged over that time above {DIVERGED_NEES:g}); 0: it did not. Kept in the ellipse: "
+    "the flight flew so"
+)
+"""``navigation_diverged``'s meaning (``sim.flight.NAVIGATION_METRICS``)."""
+
+
+def navigation_diverged(summary: dict, burnout_speed_mps) -> jnp.ndarray:
+    """1.0 where ``navigation_summary``'s errors exceed ``DIVERGED_ATTITUDE_RAD``, ``DIVERGED_VELOCITY_RAD`` (of the
+    true speed at burnout [m/s]) or ``DIVERGED_NEES``, else 0.0 (a NaN, a span that never came, does not count)."""
+    over = (summary["attitude_error_max_window_rad"] > DIVERGED_ATTITUDE_RAD) \
+        | (summary["velocity_error_burnout_mps"] > DIVERGED_VELOCITY_RAD * burnout_speed_mps) \
+        | (summary["attitude_nees_window"] > DIVERGED_NEES) | (summary["position_nees_window"] > DIVERGED_NEES)  # fmt: skip
+    return over.astype(summary["attitude_nees_window"].dtype)
+
+
+def navigation_summary(state: FilterState, burnout_speed_mps) -> dict:
+    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came, but
+    ``navigation_diverged`` (0 or 1; ``burnout_speed_mps``: the true speed at burnout [m/s], NaN before)."""
     e = state.errors
 
     def mean(total, time):
         return jnp.where(time > 0.0, total / jnp.where(time > 0.0, time, 1.0), jnp.nan)
 
-    return {
+    summary = {
         "attitude_error_rms_window_rad": jnp.sqrt(mean(e.window_attitude_sq, e.window_time)),
         "attitude_error_max_window_rad": jnp.where(e.window_time > 0.0, e.window_attitude_max, jnp.nan),
         "attitude_error_rms_ascent_rad": jnp.sqrt(mean(e.ascent_attitude_sq, e.ascent_time)),
@@ -323,3 +358,4 @@ def navigation_summary(state: FilterState) -> dict:
         "attitude_nees_window": mean(e.window_attitude_nees, e.window_time),
         "position_nees_window": mean(e.window_position_nees, e.window_time),
     }
+    return {**summary, "navigation_diverged": navigation_diverged(summary, burnout_speed_mps)}
