@@ -24,7 +24,7 @@ from ..aero.model import LinearAero, linear_derivatives, simplify
 from ..dynamics.propulsion import propellant_mass, thrust
 from ..dynamics.rigid_body import MassProperties
 from ..env.atmosphere import G0, AtmosphereProfile, air
-from ..gnc.design import PlantPoint, Schedule, gain_schedule
+from ..gnc.design import FlownLoopUnstable, PlantPoint, Schedule, gain_schedule
 from ..sim.flight import mass_properties
 from ..sim.params import FlightParams
 from .config import Campaign, ConfigError
@@ -178,7 +178,8 @@ def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
 def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
     """The campaign's gain schedule from its ``design_inputs``: speeds [m/s], altitudes [m above mean sea
     level] (the grid's altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming
-    the field if the grid does not cover the flight or a point has no stabilising design."""
+    the field if the grid does not cover the flight, a point has no stabilising design or its loop as flown (the
+    integrators stepped with gnc.guidance.integrator_gain) is not stable."""
     check_coverage(campaign, inputs)
     control = campaign.config.gnc.control
     try:
@@ -194,7 +195,10 @@ def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
                 q=np.diag(control.q_weights),
                 r=np.diag(control.r_weights),
                 method=control.discretisation,
+                integrator_gain=campaign.config.gnc.guidance.integrator_gain,
             )
+    except FlownLoopUnstable as err:
+        raise ConfigError(f"gnc.control / gnc.guidance.integrator_gain: {err}") from None
     except ValueError as err:
         raise ConfigError(f"gnc.control: {err}") from None
 
@@ -208,14 +212,16 @@ MAIN_GAINS = {"pitch": {"K_w": (1, 1), "K_q": (1, 3), "K_up": (1, 6), "K_eq": (1
 
 def schedule_summary(campaign: Campaign) -> dict:
     """The campaign's gain schedule and what it was designed from, JSON-able (``rocketmc gnc design``):
-    per grid point speed [m/s], altitude above the pad and above sea level [m], closed-loop spectral
-    radius, relative Riccati residual, K (3, 11) and its ``MAIN_GAINS``."""
+    per grid point speed [m/s], altitude above the pad and above sea level [m], the designed closed loop's
+    spectral radius and the loop's as flown (``gnc.design.flown_loop``), relative Riccati residual, K (3, 11)
+    and its ``MAIN_GAINS``."""
     config, schedule, inputs = campaign.config, campaign.gnc_schedule, campaign.gnc_inputs
     control = config.gnc.control
     points = [
         {
             "speed_mps": float(speed), "altitude_agl_m": control.altitudes_m[j],
             "altitude_msl_m": float(altitude), "spectral_radius": float(schedule.spectral_radius[i, j]),
+            "flown_spectral_radius": float(schedule.flown_radius[i, j]),
             "riccati_residual": float(schedule.residual[i, j]), "gain": schedule.gains[i, j].tolist(),
             **{row: {name: float(schedule.gains[i, j][index]) for name, index in gains.items()}
                for row, gains in MAIN_GAINS.items()},
@@ -229,6 +235,7 @@ def schedule_summary(campaign: Campaign) -> dict:
         "aero_model": config.rocket.aero.model,
         "dt_s": config.simulation.control_dt_s,
         "discretisation": control.discretisation,
+        "integrator_gain": config.gnc.guidance.integrator_gain,
         "q_weights": control.q_weights,
         "r_weights": control.r_weights,
         "state": STATE,
