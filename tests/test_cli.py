@@ -103,12 +103,15 @@ def test_gnc_design(tmp_path, capsys):
     assert {(p["speed_mps"], p["altitude_agl_m"]) for p in summary["points"]} == grid
     for p in summary["points"]:
         assert np.shape(p["gain"]) == (3, 11) and 0.0 < p["spectral_radius"] < 1.0 and p["riccati_residual"] < 1e-9
+        assert 0.0 < p["flown_spectral_radius"] < 1.0
         assert p["altitude_msl_m"] == p["altitude_agl_m"] + 1416.0 and p["pitch"]["K_up"] == p["gain"][1][6]
     assert summary["burnout"]["mass_kg"] == pytest.approx(18.362) and summary["r_weights"] == [100.0, 100.0, 100.0]
+    assert summary["integrator_gain"] == [1.0, 12.0, 12.0]
     assert png.stat().st_size > 10_000
     assert main(["gnc", "design", str(campaign)]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert "K_up" in table[3] and len(table) == 5 + len(grid)  # 3 lines of inputs, 2 of header, a row a point
+    assert "loop as flown: at most 0.99" in table[3]
+    assert "K_up" in table[4] and len(table) == 6 + len(grid)  # 4 lines of inputs, 2 of header, a row a point
     assert main(["gnc", "design", str(CAMPAIGNS / "lynx_ballistic.toml"), "--plot", str(tmp_path / "none.png")]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("rocketmc: error:") and "no [gnc] section" in err[0], err
