@@ -107,11 +107,17 @@ def test_gnc_design(tmp_path, capsys):
         assert p["altitude_msl_m"] == p["altitude_agl_m"] + 1416.0 and p["pitch"]["K_up"] == p["gain"][1][6]
     assert summary["burnout"]["mass_kg"] == pytest.approx(18.362) and summary["r_weights"] == [100.0, 100.0, 100.0]
     assert summary["integrator_gain"] == [1.0, 12.0, 12.0]
+    # lynx_nominal's rail: 84° toward 130°; no reference set but t0_s: all derived from it.
+    reference = summary["reference"]
+    assert reference["t0_s"] == {"value": 1.5, "derived": False}
+    assert all(reference[name]["derived"] for name in ("apogee_m", "flight_path_angle_deg", "heading_deg", "roll_heading_deg"))
+    assert reference["flight_path_angle_deg"]["value"] == 84.0 and reference["apogee_m"]["value"] > 0.0
     assert png.stat().st_size > 10_000
     assert main(["gnc", "design", str(campaign)]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert "loop as flown: at most 0.99" in table[3]
-    assert "K_up" in table[4] and len(table) == 6 + len(grid)  # 4 lines of inputs, 2 of header, a row a point
+    assert table[3].startswith("  guidance reference: climb H ") and "(derived)" in table[3] and "(set)" in table[3]
+    assert "loop as flown: at most 0.99" in table[4]
+    assert "K_up" in table[5] and len(table) == 7 + len(grid)  # 5 lines of inputs, 2 of header, a row a point
     assert main(["gnc", "design", str(CAMPAIGNS / "lynx_ballistic.toml"), "--plot", str(tmp_path / "none.png")]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("rocketmc: error:") and "no [gnc] section" in err[0], err

@@ -80,6 +80,10 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
         + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
     if where:
         log(where)
+    if campaign.gnc_inputs is not None:
+        from .campaign.gains import describe_reference
+
+        log(describe_reference(campaign.gnc_inputs.reference))
     flown, seconds, failed = 0, 0.0, 0
     convergence = None if args.until_converged is None else AreaConvergence(args.until_converged / 100.0)
     if convergence is not None:
@@ -326,7 +330,7 @@ def _aero_derivatives(args) -> int:
 
 def _gnc_design(args) -> int:
     from .analysis.plots import plot_gains
-    from .campaign.gains import schedule_summary
+    from .campaign.gains import describe_reference, schedule_summary
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     campaign = _campaign(args.campaign, aero_model=args.aero_model)
@@ -345,6 +349,7 @@ def _gnc_design(args) -> int:
               f"servo {summary['servo_bandwidth_rad_s']:.2f} rad/s")
         print(f"  guidance window (nominal flight, point-mass estimate): {window['speed_mps'][0]:.0f} to "
               f"{window['speed_mps'][1]:.0f} m/s, {window['altitude_agl_m'][0]:.0f} to {window['altitude_agl_m'][1]:.0f} m above the pad")
+        print(f"  {describe_reference(campaign.gnc_inputs.reference)}")
         names = [name for gains in ("pitch", "roll") for name in summary["points"][0][gains]]
         flown = max(p["flown_spectral_radius"] for p in summary["points"])
         print(f"  spectral radius of the loop as flown: at most {flown:.5f} over the grid (designed loop: "

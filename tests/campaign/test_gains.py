@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import tomllib
 
 import jax
@@ -23,6 +24,7 @@ from rocketmc.campaign.model import nominal_params
 from rocketmc.gnc.design import (
     THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, flown_loop, lqi_gain, lqi_plant,
 )  # fmt: skip
+from rocketmc.gnc.guidance import Navigation, rate_command, reference_direction
 from rocketmc.math import Quat, Vec3
 from rocketmc.sim.flight import derivatives, initial_state
 
@@ -208,3 +210,54 @@ def test_gains_are_in_the_fingerprint(linear):
     assert data_digest(other) != data_digest(linear)
     assert data_digest(campaign_from_dict(lynx("linear"), CAMPAIGNS)) == data_digest(linear)  # reproducible
     assert data_digest(dataclasses.replace(linear, gnc_schedule=None)) != data_digest(linear)
+
+
+def flown_guidance(raw: dict):
+    """The guidance parameters and the rail attitude q_nb0 a campaign flies (its nominal realization)."""
+    params = nominal_params(campaign_from_dict(raw, CAMPAIGNS))
+    return params.gnc.guidance, params.launch.q_nb0
+
+
+def test_reference_derived_from_an_88_degree_rail():
+    """Left out, the reference's γ0 is the rail's elevation (the thesis's 84° default pitched an 88° rail's
+    rocket down), its heading the launch azimuth, its roll heading the one with no roll error on the rail, its
+    climb the nominal flight's after t0."""
+    raw = lynx("linear")
+    raw["launch"].update(elevation_deg=88.0, azimuth_deg=130.0)
+    guidance, q_nb0 = flown_guidance(raw)
+    assert float(guidance.flight_path_angle_rad) == math.radians(88.0)
+    assert float(guidance.heading_rad) == math.radians(130.0)
+    # On the rail the roll command is zero: the roll error atan2(−t_b,y, t_b,z) of the derived heading, at q_nb0
+    # (rounding of the quaternion's rotation, ~1e-16 rad; 1e-12 catches any real heading error).
+    nav = Navigation(Vec3(0.0, 0.0, 0.0), Vec3(0.0, 0.0, 0.0), q_nb0, Vec3(0.0, 0.0, 0.0))
+    command, _ = rate_command(guidance, nav, jnp.asarray(guidance.window_start_s))
+    assert abs(float(command.x)) < 1e-12
+    assert float(guidance.roll_heading_rad) == pytest.approx(math.radians(130.0), abs=1e-12)  # Euler roll 0 on the rail
+    # The climb after t0 = 1.5 s of the point-mass estimate of the Lynx (no wind): below the apogee above the pad
+    # (~1.6 km) and well above nothing. Measured 1561 m.
+    assert 1000.0 < float(guidance.apogee_m) < 2000.0
+
+
+def test_reference_on_a_vertical_rail_is_clipped():
+    raw = lynx("linear")
+    raw["launch"]["elevation_deg"] = 90.0
+    guidance, _ = flown_guidance(raw)
+    assert float(guidance.flight_path_angle_rad) == math.radians(89.0)  # MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG
+    assert np.isfinite(float(reference_direction(guidance, None, jnp.asarray(3.0)).x))
+
+
+def test_reference_set_is_honoured():
+    raw = lynx("linear", gnc={"guidance": {"apogee_m": 1614.0, "flight_path_angle_deg": 84.0, "roll_heading_deg": 90.0,
+                                           "heading_deg": 100.0}})  # fmt: skip
+    raw["launch"]["elevation_deg"] = 88.0
+    campaign = campaign_from_dict(raw, CAMPAIGNS)
+    assert campaign.gnc_inputs.reference.derived == ()
+    guidance, _ = flown_guidance(raw)
+    assert float(guidance.apogee_m) == 1614.0 and float(guidance.flight_path_angle_rad) == math.radians(84.0)
+    assert float(guidance.roll_heading_rad) == math.radians(90.0) and float(guidance.heading_rad) == math.radians(100.0)
+
+
+def test_no_climb_after_t0_is_refused():
+    """t0 60 s after liftoff: the Lynx is past its apogee (~17 s) then, so no climb to derive."""
+    with pytest.raises(ConfigError, match=r"^gnc.guidance.apogee_m: the nominal flight .* does not climb after t0_s"):
+        campaign_from_dict(lynx("linear", gnc={"guidance": {"t0_s": 60.0}}), CAMPAIGNS)
