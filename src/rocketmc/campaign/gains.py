@@ -259,7 +259,8 @@ def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
                 integrator_gain=campaign.config.gnc.guidance.integrator_gain,
             )
     except FlownLoopUnstable as err:
-        raise ConfigError(f"gnc.control / gnc.guidance.integrator_gain: {err}") from None
+        raise ConfigError(f"gnc.guidance.integrator_gain: {err} (lower the integrator gains or change the design's "
+                          f"gnc.control)") from None  # fmt: skip
     except ValueError as err:
         raise ConfigError(f"gnc.control: {err}") from None
 
