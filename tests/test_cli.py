@@ -1,6 +1,8 @@
 """The command line: a small campaign end to end, and bad input (exit code 2, no result file)."""
 
 import argparse
+import contextlib
+import io
 import itertools
 import json
 import re
@@ -21,8 +23,19 @@ def small_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("run") / "ballistic.h5"
     # lynx_ballistic has no [gnc]: --controller on flies it with the defaults (the thesis's closed loop)
     args = ["-n", "6", "--seed", "7", "--controller", "on", "--out", str(out)]
-    assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), *args]) == 0
+    log = io.StringIO()
+    with contextlib.redirect_stderr(log):
+        assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), *args]) == 0
+    out.with_suffix(".log").write_text(log.getvalue())  # its progress output, for test_run_says_its_reference
     return out
+
+
+def test_run_says_its_reference(small_run):
+    """A controlled run says once what it steers to: lynx_ballistic's default [gnc] derives it all from the
+    campaign (rail 84° toward 130°)."""
+    lines = [line for line in small_run.with_suffix(".log").read_text().splitlines() if "guidance reference" in line]
+    assert len(lines) == 1 and lines[0].startswith("guidance reference: climb H ") and lines[0].count("(derived)") == 4
+    assert "γ0 84° (derived), heading 130° (derived), roll heading 130° (derived)" in lines[0], lines[0]
 
 
 def test_run_writes_the_contract(small_run):
@@ -115,7 +128,7 @@ def test_gnc_design(tmp_path, capsys):
     assert png.stat().st_size > 10_000
     assert main(["gnc", "design", str(campaign)]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert table[3].startswith("  guidance reference: climb H ") and "(derived)" in table[3] and "(set)" in table[3]
+    assert table[3].startswith("  guidance reference: climb H ") and table[3].count("(derived)") == 4
     assert "loop as flown: at most 0.99" in table[4]
     assert "K_up" in table[5] and len(table) == 7 + len(grid)  # 5 lines of inputs, 2 of header, a row a point
     assert main(["gnc", "design", str(CAMPAIGNS / "lynx_ballistic.toml"), "--plot", str(tmp_path / "none.png")]) == 2

@@ -155,7 +155,7 @@ def test_flown_loop_against_the_flights_own_step():
 
 def test_flown_loop_with_the_integrator_gain_it_was_designed_for():
     """k_int = 1 designed, 1 flown: the flown loop's spectral radius is the designed one's to the integrator
-    discretisation's half step (GNC.md's 0.99495 at 100 m/s); the same gains flown with the thesis's 12 on pitch
+    discretisation's half step (the thesis's 0.99495 at 100 m/s); the same gains flown with the thesis's 12 on pitch
     and yaw are not (roll at 12 even unstable: 1.089); designed with 12, flown with 12, they agree again."""
     a, b = lqi_plant(thesis_point(100.0, 1.2133))
     designed = design(thesis_point(100.0, 1.2133), "zoh")

@@ -552,7 +552,7 @@ class ServoConfig(_Strict):
 
 
 class GuidanceConfig(_Strict):
-    """Guidance (GNC.md §4), the thesis's gains as defaults; fixed per campaign. The reference parabola
+    """Guidance (the thesis's, docs/conventions.md), its gains as defaults; fixed per campaign. The reference parabola
     climbs apogee_m [m] after t0_s [s] from a flight-path angle flight_path_angle_deg above the horizon,
     toward heading_deg (clockwise from north); the roll steers the body z axis toward roll_heading_deg.
     Each of the four left out (None) is derived from the campaign at set-up (``campaign.gains.guidance_reference``):

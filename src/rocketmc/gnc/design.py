@@ -13,7 +13,7 @@ The loop as flown (``flown_loop``): at each period start the flight steps the in
 (forward Euler, ``guidance.integrate_errors``), then commands u = −K [x; e] with the stepped e, held over the
 period (the plant's zero-order hold). The design discretises the continuous augmentation instead (ZOH or Euler);
 the two integrator discretisations differ by half a step of the rate's integral, and their gains' flown loops
-by ≤ 1e-4 in spectral radius on the Lynx grid (docs/navigation.md, "The LQI gains and the loop as flown").
+by ≤ 5e-5 in spectral radius on the Lynx grid (docs/conventions.md, Closed loop).
 """
 
 from __future__ import annotations
