@@ -1,6 +1,8 @@
 """The command line: a small campaign end to end, and bad input (exit code 2, no result file)."""
 
 import argparse
+import contextlib
+import io
 import itertools
 import json
 import re
@@ -21,8 +23,19 @@ def small_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("run") / "ballistic.h5"
     # lynx_ballistic has no [gnc]: --controller on flies it with the defaults (the thesis's closed loop)
     args = ["-n", "6", "--seed", "7", "--controller", "on", "--out", str(out)]
-    assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), *args]) == 0
+    log = io.StringIO()
+    with contextlib.redirect_stderr(log):
+        assert main(["run", str(CAMPAIGNS / "lynx_ballistic.toml"), *args]) == 0
+    out.with_suffix(".log").write_text(log.getvalue())  # its progress output, for test_run_says_its_reference
     return out
+
+
+def test_run_says_its_reference(small_run):
+    """A controlled run says once what it steers to: lynx_ballistic's default [gnc] derives it all from the
+    campaign (rail 84° toward 130°)."""
+    lines = [line for line in small_run.with_suffix(".log").read_text().splitlines() if "guidance reference" in line]
+    assert len(lines) == 1 and lines[0].startswith("guidance reference: climb H ") and lines[0].count("(derived)") == 4
+    assert "γ0 84° (derived), heading 130° (derived), roll heading 130° (derived)" in lines[0], lines[0]
 
 
 def test_run_writes_the_contract(small_run):
@@ -103,12 +116,21 @@ def test_gnc_design(tmp_path, capsys):
     assert {(p["speed_mps"], p["altitude_agl_m"]) for p in summary["points"]} == grid
     for p in summary["points"]:
         assert np.shape(p["gain"]) == (3, 11) and 0.0 < p["spectral_radius"] < 1.0 and p["riccati_residual"] < 1e-9
+        assert 0.0 < p["flown_spectral_radius"] < 1.0
         assert p["altitude_msl_m"] == p["altitude_agl_m"] + 1416.0 and p["pitch"]["K_up"] == p["gain"][1][6]
     assert summary["burnout"]["mass_kg"] == pytest.approx(18.362) and summary["r_weights"] == [100.0, 100.0, 100.0]
+    assert summary["integrator_gain"] == [1.0, 12.0, 12.0]
+    # lynx_nominal's rail: 84° toward 130°; no reference set but t0_s: all derived from it.
+    reference = summary["reference"]
+    assert reference["t0_s"] == {"value": 1.5, "derived": False}
+    assert all(reference[name]["derived"] for name in ("apogee_m", "flight_path_angle_deg", "heading_deg", "roll_heading_deg"))
+    assert reference["flight_path_angle_deg"]["value"] == 84.0 and reference["apogee_m"]["value"] > 0.0
     assert png.stat().st_size > 10_000
     assert main(["gnc", "design", str(campaign)]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert "K_up" in table[3] and len(table) == 5 + len(grid)  # 3 lines of inputs, 2 of header, a row a point
+    assert table[3].startswith("  guidance reference: climb H ") and table[3].count("(derived)") == 4
+    assert "loop as flown: at most 0.99" in table[4]
+    assert "K_up" in table[5] and len(table) == 7 + len(grid)  # 5 lines of inputs, 2 of header, a row a point
     assert main(["gnc", "design", str(CAMPAIGNS / "lynx_ballistic.toml"), "--plot", str(tmp_path / "none.png")]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("rocketmc: error:") and "no [gnc] section" in err[0], err

@@ -80,6 +80,10 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
         + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
     if where:
         log(where)
+    if campaign.gnc_inputs is not None:
+        from .campaign.gains import describe_reference
+
+        log(describe_reference(campaign.gnc_inputs.reference))
     flown, seconds, failed = 0, 0.0, 0
     convergence = None if args.until_converged is None else AreaConvergence(args.until_converged / 100.0)
     if convergence is not None:
@@ -329,7 +333,7 @@ def _aero_derivatives(args) -> int:
 
 def _gnc_design(args) -> int:
     from .analysis.plots import plot_gains
-    from .campaign.gains import schedule_summary
+    from .campaign.gains import describe_reference, schedule_summary
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     campaign = _campaign(args.campaign, aero_model=args.aero_model)
@@ -341,18 +345,23 @@ def _gnc_design(args) -> int:
     else:
         mass, window = summary["burnout"], summary["window_estimate"]
         print(f"{summary['campaign']}: LQI gains ({summary['aero_model']} aerodynamics), {summary['discretisation']} "
-              f"over dt {summary['dt_s']:g} s, Q = diag{tuple(summary['q_weights'])}, R = diag{tuple(summary['r_weights'])}")
+              f"over dt {summary['dt_s']:g} s, Q = diag{tuple(summary['q_weights'])}, R = diag{tuple(summary['r_weights'])}, "
+              f"integrator gains {tuple(summary['integrator_gain'])}")
         print(f"  plant at burnout: mass {mass['mass_kg']:.3f} kg, CG x {mass['cg_x_m']:+.3f} m (body, from the "
               f"reference point), Ixx {mass['ixx_kgm2']:.4g}, Iyy {mass['iyy_kgm2']:.4g} kg·m²; "
               f"servo {summary['servo_bandwidth_rad_s']:.2f} rad/s")
         print(f"  guidance window (nominal flight, point-mass estimate): {window['speed_mps'][0]:.0f} to "
               f"{window['speed_mps'][1]:.0f} m/s, {window['altitude_agl_m'][0]:.0f} to {window['altitude_agl_m'][1]:.0f} m above the pad")
+        print(f"  {describe_reference(campaign.gnc_inputs.reference)}")
         names = [name for gains in ("pitch", "roll") for name in summary["points"][0][gains]]
-        print(f"  {'speed':>7}{'altitude':>10}{'radius':>10}{'residual':>10}" + "".join(f"{n:>9}" for n in names))
-        print(f"  {'[m/s]':>7}{'[m AGL]':>10}")
+        flown = max(p["flown_spectral_radius"] for p in summary["points"])
+        print(f"  spectral radius of the loop as flown: at most {flown:.5f} over the grid (designed loop: "
+              f"{max(p['spectral_radius'] for p in summary['points']):.5f})")
+        print(f"  {'speed':>7}{'altitude':>10}{'flown':>10}{'designed':>10}{'residual':>10}" + "".join(f"{n:>9}" for n in names))
+        print(f"  {'[m/s]':>7}{'[m AGL]':>10}{'radius':>10}{'radius':>10}")
         for p in summary["points"]:
             gains = [p[row][name] for row in ("pitch", "roll") for name in p[row]]
-            print(f"  {p['speed_mps']:>7g}{p['altitude_agl_m']:>10g}{p['spectral_radius']:>10.5f}"
+            print(f"  {p['speed_mps']:>7g}{p['altitude_agl_m']:>10g}{p['flown_spectral_radius']:>10.5f}{p['spectral_radius']:>10.5f}"
                   f"{p['riccati_residual']:>10.1e}" + "".join(f"{k:>9.4f}" for k in gains))
     if plot:
         plot_gains(summary, plot)

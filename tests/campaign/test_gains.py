@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import tomllib
 
 import jax
@@ -16,11 +17,14 @@ import pytest
 
 from rocketmc.aero.canards import allocate
 from rocketmc.campaign import campaign_from_dict
-from rocketmc.campaign.config import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS, preset_rocket
+from rocketmc.campaign.config import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS, ConfigError, preset_rocket
 from rocketmc.campaign.fingerprint import data_digest
 from rocketmc.campaign.gains import design_inputs, plant_point
 from rocketmc.campaign.model import nominal_params
-from rocketmc.gnc.design import THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, lqi_gain, lqi_plant
+from rocketmc.gnc.design import (
+    THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, flown_loop, lqi_gain, lqi_plant,
+)  # fmt: skip
+from rocketmc.gnc.guidance import Navigation, rate_command, reference_direction
 from rocketmc.math import Quat, Vec3
 from rocketmc.sim.flight import derivatives, initial_state
 
@@ -53,7 +57,8 @@ def test_linear_schedule_is_the_thesis_plant_at_burnout(linear):
     """A grid point of the linear Lynx against GNC.md §5's plant written by hand: LYNX.md's coefficients
     (force damping 154 per ω·d/V), the Lynx at burnout (18.362 kg, Ixx 0.06, Iyy 6.436 kg·m², its CG on the
     moment reference, so no shift), S 0.01767 m², d 0.15 m, ρ of the ISA at the grid altitude above
-    Roccaraso, ω_a = 1/0.0769 s, dt 0.02 s, ZOH, the weights flown."""
+    Roccaraso, ω_a = 1/0.0769 s, dt 0.02 s, ZOH, the weights flown, the integrators augmented with the gains
+    they are flown with (1, 12, 12: gnc.guidance.integrator_gain's default)."""
     schedule = linear.gnc_schedule
     i, j = DEFAULT_SPEEDS_MPS.index(150.0), DEFAULT_ALTITUDES_M.index(1000.0)
     assert schedule.speeds[i] == 150.0 and schedule.altitudes[j] == SITE_M + 1000.0  # altitudes above sea level
@@ -64,7 +69,7 @@ def test_linear_schedule_is_the_thesis_plant_at_burnout(linear):
         mass=18.362, ixx=0.06, iyy=6.436, area=0.01767, diameter=0.15,
         speed=150.0, density=density(SITE_M + 1000.0), omega_a=1.0 / 0.0769,
     )  # fmt: skip
-    expected = lqi_gain(*discretise(*augment(*lqi_plant(point)), 0.02, "zoh"), THESIS_Q, THESIS_R)
+    expected = lqi_gain(*discretise(*augment(*lqi_plant(point), (1.0, 12.0, 12.0)), 0.02, "zoh"), THESIS_Q, THESIS_R)
     # The same arithmetic but for the coefficients' trip through the mixing matrix and the table
     # (rounding ~1e-16 relative) and the propellant left at burnout (0 to rounding): K (|K| ≲ 2)
     # agrees to ~1e-14; 1e-12 leaves room and still catches any real difference.
@@ -78,8 +83,35 @@ def test_default_lynx_schedule_is_stable_and_solved(model, request):
     assert schedule.gains.shape == (len(DEFAULT_SPEEDS_MPS), len(DEFAULT_ALTITUDES_M), 3, 11)
     np.testing.assert_array_equal(schedule.altitudes, SITE_M + np.asarray(DEFAULT_ALTITUDES_M))
     assert np.all(schedule.spectral_radius < 1.0), schedule.spectral_radius.max()
+    assert np.all(schedule.flown_radius < 1.0), schedule.flown_radius.max()
     # scipy's Schur solution satisfies the DARE to rounding (measured < 5e-14 relative).
     assert np.all(schedule.residual < 1e-9), schedule.residual.max()
+
+
+def test_flown_loop_of_the_default_lynx_schedule(linear):
+    """The loop as flown (the plant, the schedule's K, the integrators stepped with k_int = 1, 12, 12, in the
+    flight's order) at every point of the default grid: stable, and its spectral radius the designed loop's to
+    1e-3 (the two integrator discretisations differ by half a step of the rate's integral: measured ≤ 4.9e-4 on
+    this grid, at 300 m/s, growing with speed). The gains designed with k_int = 1 and flown with 12 were stable here too (≤ 0.9971) but their
+    designed radius (≤ 0.9988) was not what flew: 1.7e-3 apart at 20 m/s, 3.2e-2 at 300 m/s."""
+    inputs, schedule = linear.gnc_inputs, linear.gnc_schedule
+    flown = np.zeros(schedule.spectral_radius.shape)
+    for i, speed in enumerate(schedule.speeds):
+        for j, altitude in enumerate(schedule.altitudes):
+            a, b = lqi_plant(plant_point(inputs.aero, inputs.mass, speed, altitude, inputs.omega_a))
+            flown[i, j] = np.abs(np.linalg.eigvals(flown_loop(a, b, schedule.gains[i, j], (1.0, 12.0, 12.0), 0.02))).max()
+    np.testing.assert_array_equal(flown, schedule.flown_radius)  # the same arithmetic
+    assert flown.max() < 1.0
+    np.testing.assert_allclose(flown, schedule.spectral_radius, rtol=0, atol=1e-3)
+
+
+def test_unstable_flown_loop_is_refused():
+    """Integrator gains of 500 on every axis: each point's design (ZOH of ė = −500 C x) is stable, but from 200 m/s
+    on (first in the grid's order) the flight's forward-Euler step of the integrators (k_int·T = 10) is not
+    (flown spectral radius 1.0021 there)."""
+    with pytest.raises(ConfigError, match=r"^gnc.guidance.integrator_gain: LQI design at speed 200 m/s.* the loop as flown "
+                                          r".* is not stable, spectral radius 1.002.*gnc.control\)$"):  # fmt: skip
+        campaign_from_dict(lynx("linear", gnc={"guidance": {"integrator_gain": [500.0, 500.0, 500.0]}}), CAMPAIGNS)
 
 
 def test_interpolated_designs_on_its_own_linearisation(simplified):
@@ -178,3 +210,54 @@ def test_gains_are_in_the_fingerprint(linear):
     assert data_digest(other) != data_digest(linear)
     assert data_digest(campaign_from_dict(lynx("linear"), CAMPAIGNS)) == data_digest(linear)  # reproducible
     assert data_digest(dataclasses.replace(linear, gnc_schedule=None)) != data_digest(linear)
+
+
+def flown_guidance(raw: dict):
+    """The guidance parameters and the rail attitude q_nb0 a campaign flies (its nominal realization)."""
+    params = nominal_params(campaign_from_dict(raw, CAMPAIGNS))
+    return params.gnc.guidance, params.launch.q_nb0
+
+
+def test_reference_derived_from_an_88_degree_rail():
+    """Left out, the reference's γ0 is the rail's elevation (the thesis's 84° default pitched an 88° rail's
+    rocket down), its heading the launch azimuth, its roll heading the one with no roll error on the rail, its
+    climb the nominal flight's after t0."""
+    raw = lynx("linear")
+    raw["launch"].update(elevation_deg=88.0, azimuth_deg=130.0)
+    guidance, q_nb0 = flown_guidance(raw)
+    assert float(guidance.flight_path_angle_rad) == math.radians(88.0)
+    assert float(guidance.heading_rad) == math.radians(130.0)
+    # On the rail the roll command is zero: the roll error atan2(−t_b,y, t_b,z) of the derived heading, at q_nb0
+    # (rounding of the quaternion's rotation, ~1e-16 rad; 1e-12 catches any real heading error).
+    nav = Navigation(Vec3(0.0, 0.0, 0.0), Vec3(0.0, 0.0, 0.0), q_nb0, Vec3(0.0, 0.0, 0.0))
+    command, _ = rate_command(guidance, nav, jnp.asarray(guidance.window_start_s))
+    assert abs(float(command.x)) < 1e-12
+    assert float(guidance.roll_heading_rad) == pytest.approx(math.radians(130.0), abs=1e-12)  # Euler roll 0 on the rail
+    # The climb after t0 = 1.5 s of the point-mass estimate of the Lynx (no wind): below the apogee above the pad
+    # (~1.6 km) and well above nothing. Measured 1561 m.
+    assert 1000.0 < float(guidance.apogee_m) < 2000.0
+
+
+def test_reference_on_a_vertical_rail_is_clipped():
+    raw = lynx("linear")
+    raw["launch"]["elevation_deg"] = 90.0
+    guidance, _ = flown_guidance(raw)
+    assert float(guidance.flight_path_angle_rad) == math.radians(89.0)  # MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG
+    assert np.isfinite(float(reference_direction(guidance, None, jnp.asarray(3.0)).x))
+
+
+def test_reference_set_is_honoured():
+    raw = lynx("linear", gnc={"guidance": {"apogee_m": 1614.0, "flight_path_angle_deg": 84.0, "roll_heading_deg": 90.0,
+                                           "heading_deg": 100.0}})  # fmt: skip
+    raw["launch"]["elevation_deg"] = 88.0
+    campaign = campaign_from_dict(raw, CAMPAIGNS)
+    assert campaign.gnc_inputs.reference.derived == ()
+    guidance, _ = flown_guidance(raw)
+    assert float(guidance.apogee_m) == 1614.0 and float(guidance.flight_path_angle_rad) == math.radians(84.0)
+    assert float(guidance.roll_heading_rad) == math.radians(90.0) and float(guidance.heading_rad) == math.radians(100.0)
+
+
+def test_no_climb_after_t0_is_refused():
+    """t0 60 s after liftoff: the Lynx is past its apogee (~17 s) then, so no climb to derive."""
+    with pytest.raises(ConfigError, match=r"^gnc.guidance.apogee_m: the nominal flight .* does not climb after t0_s"):
+        campaign_from_dict(lynx("linear", gnc={"guidance": {"t0_s": 60.0}}), CAMPAIGNS)

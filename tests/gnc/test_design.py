@@ -24,6 +24,7 @@ from rocketmc.gnc.design import (
     augment,
     density,
     discretise,
+    flown_loop,
     gain_schedule,
     lqi_gain,
     lqi_plant,
@@ -115,6 +116,55 @@ def test_augment_appends_the_negative_rate_integrators():
     np.testing.assert_array_equal(a[8:], expected)
     np.testing.assert_array_equal(a[:8, 8:], 0.0)
     np.testing.assert_array_equal(b[8:], 0.0)
+
+
+def test_augment_scales_the_integrators_by_their_gains():
+    a, b = augment(*lqi_plant(thesis_point(100.0, 1.2)), (1.0, 12.0, 7.5))
+    expected = np.zeros((3, 11))
+    expected[[0, 1, 2], [2, 3, 4]] = -1.0, -12.0, -7.5
+    np.testing.assert_array_equal(a[8:], expected)
+
+
+def flight_step(a, b, gain, integrator_gain, dt, z):
+    """One control period of the flight's own code on z = [x; e] (e before the step), ω_cmd = 0: the integrators
+    stepped by ``guidance.integrate_errors``, u by ``control.lqi_command`` on the stepped ones, the plant over
+    dt by scipy.signal's zero-order hold."""
+    from rocketmc.gnc.control import lqi_command
+    from rocketmc.gnc.guidance import integrate_errors
+    from rocketmc.math import Vec3
+
+    x, e = z[:8], z[8:]
+    rates, zero = Vec3(*map(float, x[2:5])), Vec3(0.0, 0.0, 0.0)
+    stepped = integrate_errors(Vec3(*map(float, e)), zero, rates, dt, True, Vec3(*integrator_gain))
+    stepped = np.array([float(v) for v in stepped])
+    u = np.array([float(v) for v in lqi_command(gain.ravel(), (*x, *stepped))])
+    ad, bd, *_ = scipy.signal.cont2discrete((a, b, np.eye(8), np.zeros((8, 3))), dt, method="zoh")
+    return np.concatenate([ad @ x + bd @ u, stepped])
+
+
+def test_flown_loop_against_the_flights_own_step():
+    """Each column of ``flown_loop`` is one period of the flight's own integrator step and command (JAX, float64
+    here) from a unit state, through an independent ZOH: equal to rounding."""
+    a, b = lqi_plant(thesis_point(100.0, 1.2133))
+    gain = design(thesis_point(100.0, 1.2133), "zoh").gain
+    loop = flown_loop(a, b, gain, (1.0, 12.0, 12.0), THESIS_DT)
+    columns = np.column_stack([flight_step(a, b, gain, (1.0, 12.0, 12.0), THESIS_DT, z) for z in np.eye(11)])
+    # Entries ≲ 1e1, two ZOH codes and the flight's sums in another order: rounding ~1e-14.
+    np.testing.assert_allclose(loop, columns, rtol=0, atol=1e-12)
+
+
+def test_flown_loop_with_the_integrator_gain_it_was_designed_for():
+    """k_int = 1 designed, 1 flown: the flown loop's spectral radius is the designed one's to the integrator
+    discretisation's half step (the thesis's 0.99495 at 100 m/s); the same gains flown with the thesis's 12 on pitch
+    and yaw are not (roll at 12 even unstable: 1.089); designed with 12, flown with 12, they agree again."""
+    a, b = lqi_plant(thesis_point(100.0, 1.2133))
+    designed = design(thesis_point(100.0, 1.2133), "zoh")
+    radius = lambda gain, k_int: np.abs(np.linalg.eigvals(flown_loop(a, b, gain, k_int, THESIS_DT))).max()  # noqa: E731
+    assert radius(designed.gain, (1.0, 1.0, 1.0)) == pytest.approx(designed.spectral_radius, abs=1e-4)
+    assert radius(designed.gain, (12.0, 12.0, 12.0)) > 1.0
+    assert abs(radius(designed.gain, (1.0, 12.0, 12.0)) - designed.spectral_radius) > 1e-2
+    flown_12 = lqi_gain(*discretise(*augment(a, b, (1.0, 12.0, 12.0)), THESIS_DT, "zoh"), THESIS_Q, THESIS_R)
+    assert radius(flown_12.gain, (1.0, 12.0, 12.0)) == pytest.approx(flown_12.spectral_radius, abs=1e-4)
 
 
 def test_zoh_matches_scipy_signal():
@@ -230,8 +280,8 @@ def test_gain_schedule_over_a_small_grid(method):
     speeds, altitudes = (60.0, 150.0, 250.0), (0.0, 1500.0)
     schedule = gain_schedule(lynx_at, speeds, altitudes, method=method)
     assert schedule.gains.shape == (3, 2, 3, 11)
-    assert schedule.spectral_radius.shape == schedule.residual.shape == (3, 2)
-    assert np.all(schedule.spectral_radius < 1.0)
+    assert schedule.spectral_radius.shape == schedule.residual.shape == schedule.flown_radius.shape == (3, 2)
+    assert np.all(schedule.spectral_radius < 1.0) and np.all(schedule.flown_radius < 1.0)
     assert np.all(schedule.residual < 1e-9)  # as in test_dare_against_riccati_iteration
     np.testing.assert_array_equal(schedule.speeds, speeds)
     # Each cell is the single-point design at that speed and ISA density (same code path: bit-equal).

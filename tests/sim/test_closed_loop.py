@@ -58,8 +58,10 @@ def flight_path_deg(traj):
 @pytest.mark.parametrize("case, start", [("1s", 1.0), ("3p5s", 3.5)])
 def test_controller_pulls_the_flight_path_onto_the_reference(flights, case, start):
     """Open loop, the rocket weathercocks into the headwind: γ falls ~20° below the reference by 10 s. With the
-    controller on, γ is within 1.5° of the reference from 4 s after the window opens to its end (measured with the
-    linear model: 0.46° from 1 s, 1.13° from 3.5 s), and the active time is the window's length."""
+    controller on, γ is within 1.5° of the reference from 5 s after the window opens to its end (measured with the
+    linear model and the gains designed for the integrator gains flown, 1, 12, 12: 0.86° from 1 s, 1.25° from
+    3.5 s; 4 s after it opens 1.00° and 2.14°. The gains designed for integrator gain 1 and flown with 12 held
+    0.46° and 1.13° 4 s after), and the active time is the window's length."""
     _, off, _ = flights["off"]
     p, traj, summary = flights[case]
     t = np.asarray(traj.t)
@@ -67,7 +69,7 @@ def test_controller_pulls_the_flight_path_onto_the_reference(flights, case, star
     assert 0.5 < liftoff < 0.6  # ignition at 0.5 s, thrust over weight a few periods later
     d = reference_direction(p.gnc.guidance, None, t - liftoff)
     reference = np.degrees(np.arcsin(-np.asarray(d.z)))
-    settled = (t - liftoff >= start + 4.0) & (t - liftoff < 10.0)
+    settled = (t - liftoff >= start + 5.0) & (t - liftoff < 10.0)
     assert np.abs(flight_path_deg(traj) - reference)[settled].max() < 1.5
     assert (reference - flight_path_deg(off))[np.searchsorted(t, liftoff + 10.0)] > 15.0
     # One control period of rounding: the window opens at the first period start at or after it.

@@ -261,19 +261,21 @@ def _save(fig: Figure, path: str | Path) -> None:
 
 def plot_gains(summary: dict, path: str | Path | None = None) -> Figure:
     """The LQI gain schedule of ``campaign.gains.schedule_summary``: the main pitch and roll gains and the
-    closed-loop spectral radius against speed [m/s], one line per design altitude above the pad; saved
-    to ``path`` if given."""
+    spectral radius of the loop as flown (solid; the designed loop's dashed) against speed [m/s], one line per
+    design altitude above the pad; saved to ``path`` if given."""
     points = summary["points"]
-    panels = [(row, name) for row in ("pitch", "roll") for name in points[0][row]] + [(None, "spectral_radius")]
+    panels = [(row, name) for row in ("pitch", "roll") for name in points[0][row]] + [(None, "flown_spectral_radius")]
     fig = Figure(figsize=(13.0, 6.5), layout="constrained")
     axes = fig.subplots(2, 4, sharex=True).ravel()
     for altitude in sorted({p["altitude_agl_m"] for p in points}):
         at = [p for p in points if p["altitude_agl_m"] == altitude]
         speeds = [p["speed_mps"] for p in at]
         for ax, (row, name) in zip(axes, panels):
-            ax.plot(speeds, [p[name] if row is None else p[row][name] for p in at], marker=".", label=f"{altitude:g} m")
+            line, = ax.plot(speeds, [p[name] if row is None else p[row][name] for p in at], marker=".",
+                            label=f"{altitude:g} m")  # fmt: skip
+        axes[len(panels) - 1].plot(speeds, [p["spectral_radius"] for p in at], ls="--", color=line.get_color())
     for ax, (row, name) in zip(axes, panels):
-        ax.set_title(name.replace("_", " ") if row is None else f"{row} {name}")
+        ax.set_title("spectral radius, flown (designed dashed)" if row is None else f"{row} {name}")
         ax.grid(True, alpha=0.4)
     for ax in axes[4:]:
         ax.set_xlabel("speed [m/s]")

@@ -589,19 +589,26 @@ class ServoConfig(_Strict):
 
 
 class GuidanceConfig(_Strict):
-    """Guidance (GNC.md §4), the thesis's values as defaults; fixed per campaign. The reference parabola
+    """Guidance (the thesis's, docs/conventions.md), its gains as defaults; fixed per campaign. The reference parabola
     climbs apogee_m [m] after t0_s [s] from a flight-path angle flight_path_angle_deg above the horizon,
-    toward heading_deg (clockwise from north; None: launch.azimuth_deg)."""
+    toward heading_deg (clockwise from north); the roll steers the body z axis toward roll_heading_deg.
+    Each of the four left out (None) is derived from the campaign at set-up (``campaign.gains.guidance_reference``):
+    the launch azimuth, the nominal rail's elevation (at most 89°), the rail's roll, the nominal flight's climb
+    after t0_s (a point-mass estimate). The thesis flew H 1614 m, 84°, roll heading 90°."""
 
-    apogee_m: Height = Field(1614.0, description="the reference parabola's climb after t0_s")
+    apogee_m: Height | None = Field(None, description="the reference parabola's climb after t0_s (none: the nominal flight's)")
     t0_s: float = Field(1.5, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
-    flight_path_angle_deg: float = Field(84.0, gt=0, lt=90, description="the parabola's initial angle above the horizon")
+    flight_path_angle_deg: float | None = Field(
+        None, gt=0, lt=90, description="the parabola's angle above the horizon at t0_s (none: the rail's, at most 89)"
+    )
     heading_deg: Direction | None = Field(None, description="clockwise from north (none: launch.azimuth_deg)")
     gain: float = Field(5.0, ge=0, le=MAX_GUIDANCE_GAIN, description="k [1/s]")
     rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S, description="pitch/yaw command, 2-norm")
     min_speed_mps: float = Field(1.0, ge=0, le=MAX_SPEED_MPS, description="no pitch/yaw command below")
     roll_gain: float = Field(1.0, ge=0, le=MAX_GUIDANCE_GAIN, description="[1/s]")
-    roll_heading_deg: Direction = Field(90.0, description="azimuth the body z axis is steered toward")
+    roll_heading_deg: Direction | None = Field(
+        None, description="azimuth the body z axis is steered toward (none: its azimuth on the rail, no roll manoeuvre)"
+    )
     roll_rate_limit_deg_s: float = Field(20.0, gt=0, le=MAX_RATE_DEG_S, description="largest commanded roll rate [deg/s]")
     integrator_gain: list[Annotated[float, Field(ge=0, le=MAX_GUIDANCE_GAIN)]] = Field(
         [1.0, 12.0, 12.0], min_length=3, max_length=3, description="k_int of e_p, e_q, e_r [-]"

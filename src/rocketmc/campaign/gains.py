@@ -5,7 +5,8 @@ Each grid point (axial speed u [m/s], altitude) is ``gnc.design``'s linear plant
 campaign's own aerodynamic model at α = β = δ = 0 (its simplified form: the linear model as given,
 the simplified table, or ``simplify`` of the interpolated tables) and from the nominal rocket at
 burnout: the coast, where most of the guidance window lies. Before the design, the grid is checked
-against a point-mass estimate of the nominal flight inside the guidance window.
+against a point-mass estimate of the nominal flight inside the guidance window; the same estimate gives the
+guidance reference's climb when the campaign leaves it out (``guidance_reference``).
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from ..aero.model import LinearAero, linear_derivatives, simplify
 from ..dynamics.propulsion import propellant_mass, thrust
 from ..dynamics.rigid_body import MassProperties
 from ..env.atmosphere import G0, AtmosphereProfile, air
-from ..gnc.design import PlantPoint, Schedule, gain_schedule
+from ..gnc.design import FlownLoopUnstable, PlantPoint, Schedule, gain_schedule
+from ..math.vectors import Vec3
 from ..sim.flight import mass_properties
 from ..sim.params import FlightParams
 from .config import Campaign, ConfigError
@@ -34,13 +36,32 @@ ESTIMATE_DT_S = 0.01
 """Step of the point-mass estimate [s]: Lynx's window speeds are within 0.3 % of a step ten times smaller."""
 ESTIMATE_HEIGHTS_M = np.linspace(0.0, 50_000.0, 1001)
 """Heights above the pad [m] the estimate tabulates the air on: every 50 m to 50 km (the ISA ends at 47 km)."""
+MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG = 89.0
+"""The derived reference's angle at t0 is the rail's elevation, at most this [deg]: on a vertical rail the parabola's
+horizontal speed c1/tan γ0 is 0, its γ_ref jumps from +90° to −90° at its apogee and its heading is void; at 89° it
+is 1.7 % of the climb rate c1 (3 m/s for a 1600 m climb)."""
+
+
+class GuidanceReference(NamedTuple):
+    """The reference guidance steers to (``gnc.guidance.GuidanceParams``): apogee_m, its climb H after t0_s [m];
+    t0_s [s since liftoff]; flight_path_angle_deg, γ0 above the horizon at t0; heading_deg, its azimuth; roll_heading_deg,
+    the azimuth the body z axis is steered toward [deg, clockwise from north]. derived: the names of those derived
+    from the campaign (left out of gnc.guidance)."""
+
+    apogee_m: float
+    t0_s: float
+    flight_path_angle_deg: float
+    heading_deg: float
+    roll_heading_deg: float
+    derived: tuple[str, ...]
 
 
 class DesignInputs(NamedTuple):
     """What the gains are designed from: aero, the campaign's model in its simplified form; mass, the
     nominal rocket at burnout (mass [kg], CG body x [m], inertia [kg·m²]); omega_a, the servo bandwidth
     1/τ [rad/s]; speeds [m/s] and altitudes_agl [m above the pad], the nominal flight's range inside the
-    guidance window (point-mass estimate, ``window_envelope``); atmosphere: the day's air (None: the ISA)."""
+    guidance window (point-mass estimate, ``nominal_estimate``); atmosphere: the day's air (None: the ISA);
+    reference: what guidance steers to (``guidance_reference``)."""
 
     aero: LinearAero
     mass: MassProperties
@@ -48,6 +69,7 @@ class DesignInputs(NamedTuple):
     speeds: tuple[float, float]
     altitudes_agl: tuple[float, float]
     atmosphere: AtmosphereProfile | None = None
+    reference: GuidanceReference | None = None
 
 
 def design_inputs(campaign: Campaign) -> DesignInputs:
@@ -64,10 +86,35 @@ def design_inputs(campaign: Campaign) -> DesignInputs:
     times = jnp.arange(0.0, float(motor.ignition_time_s + motor.burn_time_s), ESTIMATE_DT_S)
     mass, *arrays = _nominal_arrays(params, times, jnp.asarray(ESTIMATE_HEIGHTS_M))
     guidance = campaign.config.gnc.guidance
-    speeds, altitudes = window_envelope(params, aero, *map(np.asarray, arrays), guidance.window_start_s,
-                                        guidance.window_end_s)  # fmt: skip
+    speeds, altitudes, climb = nominal_estimate(params, aero, *map(np.asarray, arrays), guidance.window_start_s,
+                                                guidance.window_end_s, guidance.t0_s)  # fmt: skip
     return DesignInputs(aero, mass, 1.0 / campaign.config.gnc.servo.time_constant_s, speeds, altitudes,
-                        params.environment.atmosphere)  # fmt: skip
+                        params.environment.atmosphere, guidance_reference(campaign, params, climb))  # fmt: skip
+
+
+def guidance_reference(campaign: Campaign, params: FlightParams, climb_m: float) -> GuidanceReference:
+    """The reference of the campaign's gnc.guidance, those of its fields left out derived from the nominal flight
+    ``params``: heading, the launch azimuth; flight-path angle, the rail's elevation (at most
+    MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG); roll heading, the azimuth of the horizontal direction that the rail's attitude
+    q_nb0 already steers to (perpendicular to the body y axis, on the body z axis's side: no roll error there, so no
+    roll manoeuvre at the window's start); apogee, ``climb_m`` [m], the nominal flight's climb after t0_s
+    (``nominal_estimate``). ConfigError naming gnc.guidance.apogee_m if that climb is not positive."""
+    g, launch = campaign.config.gnc.guidance, campaign.config.launch
+    y_b = params.launch.q_nb0.rotate(Vec3(0.0, 1.0, 0.0))
+    z_b = params.launch.q_nb0.rotate(Vec3(0.0, 0.0, 1.0))
+    north, east = -float(y_b.y), float(y_b.x)  # ⟂ y_b and horizontal: D × y_b
+    side = math.copysign(1.0, north * float(z_b.x) + east * float(z_b.y))
+    derived = {
+        "apogee_m": climb_m,
+        "flight_path_angle_deg": min(launch.elevation_deg, MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG),
+        "heading_deg": launch.azimuth_deg,
+        "roll_heading_deg": math.degrees(math.atan2(side * east, side * north)) % 360.0,
+    }
+    if g.apogee_m is None and not climb_m > 0.0:
+        raise ConfigError(f"gnc.guidance.apogee_m: the nominal flight (a point-mass estimate) does not climb after "
+                          f"t0_s = {g.t0_s:g} s; set apogee_m or an earlier t0_s")  # fmt: skip
+    values = {name: float(derived[name]) if getattr(g, name) is None else getattr(g, name) for name in derived}
+    return GuidanceReference(t0_s=g.t0_s, derived=tuple(name for name in derived if getattr(g, name) is None), **values)
 
 
 @jax.jit
@@ -107,14 +154,16 @@ def plant_point(
     )  # fmt: skip
 
 
-def window_envelope(params: FlightParams, aero: LinearAero, thrust_n, propellant_kg, density, sound, start_s, end_s):
+def nominal_estimate(params: FlightParams, aero: LinearAero, thrust_n, propellant_kg, density, sound, start_s, end_s,
+                     t0_s):  # fmt: skip
     """((min, max) speed [m/s], (min, max) altitude above the pad [m]) of the nominal flight off the
-    rail (on it the rocket cannot turn) from ``start_s`` to ``end_s`` after liftoff (first motion),
-    estimated: a point mass up the rail, then turning under gravity (thrust and drag along the
-    velocity), with the thrust [N] and propellant [kg] every ESTIMATE_DT_S from t = 0 to burnout,
-    the zero-lift drag drag_scale·CA0(Mach) at the pad's altitude (no power-on change, no airbrakes)
-    and the air's density and speed of sound at ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for
-    Lynx. ConfigError if the flight is not in the air then."""
+    rail (on it the rocket cannot turn) from ``start_s`` to ``end_s`` after liftoff (first motion), and its
+    climb from ``t0_s`` after liftoff to its apogee [m] (≤ 0 if it is past its apogee then, −inf if landed), estimated: a
+    point mass up the rail, then turning under gravity (thrust and drag along the velocity), with the thrust [N]
+    and propellant [kg] every ESTIMATE_DT_S from t = 0 to burnout, the zero-lift drag drag_scale·CA0(Mach) at the
+    pad's altitude (no power-on change, no airbrakes) and the air's density and speed of sound at
+    ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for Lynx's window (~60 ms to its apogee). ConfigError if the
+    flight is not in the air in the window."""
     site, motor = float(params.environment.site_altitude_m), params.rocket.motor
     heights = ESTIMATE_HEIGHTS_M
     mach_axis = np.asarray(aero.table.axes[aero.table.axis_names.index("mach")])
@@ -126,7 +175,7 @@ def window_envelope(params: FlightParams, aero: LinearAero, thrust_n, propellant
 
     dt = ESTIMATE_DT_S
     x = z = vx = vz = 0.0  # along the azimuth and up from the start [m], velocity [m/s]
-    liftoff, speeds, altitudes = None, [], []
+    liftoff, speeds, altitudes, times, heights_flown = None, [], [], [], []
     for k in itertools.count():
         burning = k < thrust_n.size
         if liftoff is None and not burning:
@@ -146,9 +195,11 @@ def window_envelope(params: FlightParams, aero: LinearAero, thrust_n, propellant
             liftoff = k * dt
         if liftoff is not None:
             since = k * dt - liftoff
-            if since > end_s or (z < 0.0 and vz < 0.0):
-                break
-            if since >= start_s and not on_rail:
+            if (since > max(end_s, t0_s) and vz < 0.0 and not on_rail) or (z < 0.0 and vz < 0.0):
+                break  # past the window, t0 and the apogee, or back on the ground
+            times.append(since)
+            heights_flown.append(z)
+            if start_s <= since <= end_s and not on_rail:
                 speeds.append(speed)
                 altitudes.append(z)
         x, z = x + (vx + 0.5 * ax * dt) * dt, z + (vz + 0.5 * az * dt) * dt
@@ -156,7 +207,17 @@ def window_envelope(params: FlightParams, aero: LinearAero, thrust_n, propellant
     if not speeds:
         raise ConfigError(f"gnc.guidance.window_start_s: the nominal flight (a point-mass estimate) is not in the air "
                           f"from {start_s:g} to {end_s:g} s after liftoff")  # fmt: skip
-    return (float(min(speeds)), float(max(speeds))), (float(min(altitudes)), float(max(altitudes)))
+    climb = max(heights_flown) - float(np.interp(t0_s, times, heights_flown, right=np.inf))  # −inf: landed by t0
+    return (float(min(speeds)), float(max(speeds))), (float(min(altitudes)), float(max(altitudes))), climb
+
+
+def describe_reference(reference: GuidanceReference) -> str:
+    """One line: the reference guidance steers to, each value marked (derived) or (set)."""
+    mark = lambda name: "derived" if name in reference.derived else "set"  # noqa: E731
+    return (f"guidance reference: climb H {reference.apogee_m:.0f} m ({mark('apogee_m')}) after t0 {reference.t0_s:g} s, "
+            f"γ0 {reference.flight_path_angle_deg:g}° ({mark('flight_path_angle_deg')}), heading "
+            f"{reference.heading_deg:g}° ({mark('heading_deg')}), roll heading {reference.roll_heading_deg:.4g}° "
+            f"({mark('roll_heading_deg')})")  # fmt: skip
 
 
 def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
@@ -178,7 +239,8 @@ def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
 def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
     """The campaign's gain schedule from its ``design_inputs``: speeds [m/s], altitudes [m above mean sea
     level] (the grid's altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming
-    the field if the grid does not cover the flight or a point has no stabilising design."""
+    the field if the grid does not cover the flight, a point has no stabilising design or its loop as flown (the
+    integrators stepped with gnc.guidance.integrator_gain) is not stable."""
     check_coverage(campaign, inputs)
     control = campaign.config.gnc.control
     try:
@@ -194,7 +256,11 @@ def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
                 q=np.diag(control.q_weights),
                 r=np.diag(control.r_weights),
                 method=control.discretisation,
+                integrator_gain=campaign.config.gnc.guidance.integrator_gain,
             )
+    except FlownLoopUnstable as err:
+        raise ConfigError(f"gnc.guidance.integrator_gain: {err} (lower the integrator gains or change the design's "
+                          f"gnc.control)") from None  # fmt: skip
     except ValueError as err:
         raise ConfigError(f"gnc.control: {err}") from None
 
@@ -208,14 +274,16 @@ MAIN_GAINS = {"pitch": {"K_w": (1, 1), "K_q": (1, 3), "K_up": (1, 6), "K_eq": (1
 
 def schedule_summary(campaign: Campaign) -> dict:
     """The campaign's gain schedule and what it was designed from, JSON-able (``rocketmc gnc design``):
-    per grid point speed [m/s], altitude above the pad and above sea level [m], closed-loop spectral
-    radius, relative Riccati residual, K (3, 11) and its ``MAIN_GAINS``."""
+    per grid point speed [m/s], altitude above the pad and above sea level [m], the designed closed loop's
+    spectral radius and the loop's as flown (``gnc.design.flown_loop``), relative Riccati residual, K (3, 11)
+    and its ``MAIN_GAINS``; the guidance reference, each value with whether it was derived (t0_s is always set)."""
     config, schedule, inputs = campaign.config, campaign.gnc_schedule, campaign.gnc_inputs
     control = config.gnc.control
     points = [
         {
             "speed_mps": float(speed), "altitude_agl_m": control.altitudes_m[j],
             "altitude_msl_m": float(altitude), "spectral_radius": float(schedule.spectral_radius[i, j]),
+            "flown_spectral_radius": float(schedule.flown_radius[i, j]),
             "riccati_residual": float(schedule.residual[i, j]), "gain": schedule.gains[i, j].tolist(),
             **{row: {name: float(schedule.gains[i, j][index]) for name, index in gains.items()}
                for row, gains in MAIN_GAINS.items()},
@@ -229,6 +297,7 @@ def schedule_summary(campaign: Campaign) -> dict:
         "aero_model": config.rocket.aero.model,
         "dt_s": config.simulation.control_dt_s,
         "discretisation": control.discretisation,
+        "integrator_gain": config.gnc.guidance.integrator_gain,
         "q_weights": control.q_weights,
         "r_weights": control.r_weights,
         "state": STATE,
@@ -236,5 +305,7 @@ def schedule_summary(campaign: Campaign) -> dict:
         "burnout": {"mass_kg": float(mass.mass), "cg_x_m": float(mass.cg_x), "ixx_kgm2": float(mass.ixx),
                     "iyy_kgm2": float(mass.iyy)},  # fmt: skip
         "window_estimate": {"speed_mps": list(inputs.speeds), "altitude_agl_m": list(inputs.altitudes_agl)},
+        "reference": {name: {"value": getattr(inputs.reference, name), "derived": name in inputs.reference.derived}
+                      for name in GuidanceReference._fields if name != "derived"},
         "points": points,
     }

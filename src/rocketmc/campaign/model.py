@@ -146,7 +146,8 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
 
 def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
     """The closed loop from the campaign's [gnc] (None without it): the servos from the (possibly drawn)
-    values ``v``, guidance from the config, the gains of ``campaign.gnc_schedule``."""
+    values ``v``, guidance from the config and its reference from ``campaign.gnc_inputs.reference`` (set or derived
+    at set-up), the gains of ``campaign.gnc_schedule``."""
     gnc = campaign.config.gnc
     if gnc is None:
         return None
@@ -158,14 +159,13 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
         offset_rad=jnp.deg2rad(_vector(v, f"{s}.offset_deg", len(gnc.servo.offset_deg))),
         rate_limit_rad_s=None if rate_limit is None else jnp.deg2rad(v[f"{s}.rate_limit_deg_s"]),
     )
-    g = gnc.guidance
-    heading_deg = campaign.config.launch.azimuth_deg if g.heading_deg is None else g.heading_deg
+    g, ref = gnc.guidance, campaign.gnc_inputs.reference  # the reference: set, or derived at set-up
     rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
     guidance = GuidanceParams(
-        apogee_m=jnp.asarray(g.apogee_m), t0_s=jnp.asarray(g.t0_s), flight_path_angle_rad=rad(g.flight_path_angle_deg),
-        heading_rad=rad(heading_deg), gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s),
+        apogee_m=jnp.asarray(ref.apogee_m), t0_s=jnp.asarray(g.t0_s), flight_path_angle_rad=rad(ref.flight_path_angle_deg),
+        heading_rad=rad(ref.heading_deg), gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s),
         min_speed=jnp.asarray(g.min_speed_mps), roll_gain=jnp.asarray(g.roll_gain),
-        roll_heading_rad=rad(g.roll_heading_deg), roll_rate_limit=rad(g.roll_rate_limit_deg_s),
+        roll_heading_rad=rad(ref.roll_heading_deg), roll_rate_limit=rad(g.roll_rate_limit_deg_s),
         integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
         window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
     )  # fmt: skip

@@ -5,8 +5,15 @@ a grid of speed and altitude. numpy/scipy only, run once per campaign, never tra
 Frames and states: body axes FRD (x forward along the axis, y right, z down). The plant state is
 x = [v, w, p, q, r, u_y, u_p, u_r]: v, w the body y, z components of the velocity [m/s]; p, q, r
 the body rates [rad/s]; u_y, u_p, u_r the servos' virtual yaw, pitch and roll deflections [rad].
-The augmented state appends e = [e_p, e_q, e_r] = ∫(−p, −q, −r) dt [rad]; the inputs are the three
-commanded virtual deflections [rad]; the control law is u = −K x.
+The augmented state appends e = [e_p, e_q, e_r] = ∫k_int·(−p, −q, −r) dt [rad], k_int the integrator gains
+the flight steps them with (``GuidanceParams.integrator_gain``); the inputs are the three commanded virtual
+deflections [rad]; the control law is u = −K x.
+
+The loop as flown (``flown_loop``): at each period start the flight steps the integrators e += k_int·T·(ω_cmd − ω)
+(forward Euler, ``guidance.integrate_errors``), then commands u = −K [x; e] with the stepped e, held over the
+period (the plant's zero-order hold). The design discretises the continuous augmentation instead (ZOH or Euler);
+the two integrator discretisations differ by half a step of the rate's integral, and their gains' flown loops
+by ≤ 5e-5 in spectral radius on the Lynx grid (docs/conventions.md, Closed loop).
 """
 
 from __future__ import annotations
@@ -29,6 +36,10 @@ THESIS_Q = np.diag([0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0])
 THESIS_R = 100.0 * np.eye(N_INPUT)
 THESIS_DT = 0.02  # GNC period [s]
 THESIS_OMEGA_A = 1.0 / 0.0769  # servo bandwidth, first order 1/(0.0769 s + 1) [rad/s]
+
+
+class FlownLoopUnstable(ValueError):
+    """A design whose loop as flown (``flown_loop``) is not stable at a grid point."""
 
 
 class PlantPoint(NamedTuple):
@@ -81,13 +92,15 @@ class Design(NamedTuple):
 
 class Schedule(NamedTuple):
     """Gains over a grid: speeds (n_speed,) [m/s]; altitudes (n_alt,) [m above MSL];
-    gains (n_speed, n_alt, 3, 11); spectral_radius and residual (n_speed, n_alt) [-]."""
+    gains (n_speed, n_alt, 3, 11); spectral_radius (the designed loop's) and residual (n_speed, n_alt) [-];
+    flown_radius (n_speed, n_alt) [-], the spectral radius of the loop as flown (``flown_loop``)."""
 
     speeds: np.ndarray
     altitudes: np.ndarray
     gains: np.ndarray
     spectral_radius: np.ndarray
     residual: np.ndarray
+    flown_radius: np.ndarray
 
 
 def density(altitude_msl: float) -> float:
@@ -118,10 +131,17 @@ def lqi_plant(point: PlantPoint) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
-def augment(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Append the integrators ė = −C x (C picks p, q, r) to the continuous plant: A (11, 11), B (11, 3)."""
-    c = np.zeros((N_INPUT, a.shape[0]))
+def rate_picker(n: int = N_PLANT) -> np.ndarray:
+    """C (3, n): picks the body rates p, q, r out of the plant state."""
+    c = np.zeros((N_INPUT, n))
     c[np.arange(N_INPUT), RATE_INDEX] = 1.0
+    return c
+
+
+def augment(a: np.ndarray, b: np.ndarray, integrator_gain=(1.0, 1.0, 1.0)) -> tuple[np.ndarray, np.ndarray]:
+    """Append the integrators ė = −diag(k_int) C x (C picks p, q, r; ``integrator_gain`` k_int per axis [-]) to
+    the continuous plant: A (11, 11), B (11, 3)."""
+    c = np.diag(np.asarray(integrator_gain, float)) @ rate_picker(a.shape[0])
     a_aug = np.block([[a, np.zeros((a.shape[0], N_INPUT))], [-c, np.zeros((N_INPUT, N_INPUT))]])
     return a_aug, np.vstack([b, np.zeros((N_INPUT, b.shape[1]))])
 
@@ -171,6 +191,19 @@ def lqi_gain(ad: np.ndarray, bd: np.ndarray, q: np.ndarray, r: np.ndarray, where
     return Design(gain, p, spectral_radius, residual)
 
 
+def flown_loop(a: np.ndarray, b: np.ndarray, gain: np.ndarray, integrator_gain, dt: float) -> np.ndarray:
+    """The closed loop as the flight steps it, (11, 11), on [x_k; e_k] (e_k the integrators before period k's
+    step): e_{k+1} = e_k − T diag(k_int) C x_k (no command: the loop's own dynamics), u_k = −K_x x_k − K_e e_{k+1},
+    x_{k+1} = Ad x_k + Bd u_k with (Ad, Bd) the exact zero-order hold of the continuous plant a (8, 8), b (8, 3)
+    over T = dt [s]; gain K (3, 11), integrator_gain k_int (3,) [-]. Built from the plant, K and k_int only, not
+    from the design's augmented plant."""
+    ad, bd = discretise(a, b, dt, "zoh")
+    k_x, k_e = gain[:, :N_PLANT], gain[:, N_PLANT:]
+    integrate = np.hstack([-dt * np.diag(np.asarray(integrator_gain, float)) @ rate_picker(), np.eye(N_INPUT)])
+    command = np.hstack([k_x, np.zeros((N_INPUT, N_INPUT))]) + k_e @ integrate  # u_k = −command [x_k; e_k]
+    return np.vstack([np.hstack([ad, np.zeros((N_PLANT, N_INPUT))]) - bd @ command, integrate])
+
+
 def gain_schedule(
     point_at: Callable[[float, float], PlantPoint],
     speeds,
@@ -179,12 +212,14 @@ def gain_schedule(
     q: np.ndarray = THESIS_Q,
     r: np.ndarray = THESIS_R,
     method: str = "zoh",
+    integrator_gain=(1.0, 1.0, 1.0),
 ) -> Schedule:
     """LQI gains over the grid speeds × altitudes ([m/s] × [m above MSL], each strictly increasing).
 
     ``point_at(speed, altitude)`` gives the plant there (mass, inertia and coefficients at the
-    design point, ρ e.g. from ``density(altitude)``); each point is augmented, discretised with
-    ``method`` over dt [s] and designed with ``lqi_gain``. A failing point raises ValueError
+    design point, ρ e.g. from ``density(altitude)``); each point is augmented with the integrator gains
+    ``integrator_gain`` (k_int per axis [-], as flown), discretised with ``method`` over dt [s] and designed
+    with ``lqi_gain``; its loop as flown (``flown_loop``) must be stable too. A failing point raises ValueError
     naming its speed and altitude.
     """
     speeds, altitudes = np.asarray(speeds, float), np.asarray(altitudes, float)
@@ -192,10 +227,16 @@ def gain_schedule(
         if grid.ndim != 1 or grid.size == 0 or np.any(np.diff(grid) <= 0.0):
             raise ValueError(f"gain schedule: {name} must be a non-empty, strictly increasing 1-D grid")
     gains = np.zeros((speeds.size, altitudes.size, N_INPUT, N_STATE))
-    radius, residual = np.zeros(gains.shape[:2]), np.zeros(gains.shape[:2])
+    radius, residual, flown = (np.zeros(gains.shape[:2]) for _ in range(3))
     for i, speed in enumerate(speeds):
         for j, altitude in enumerate(altitudes):
-            ad, bd = discretise(*augment(*lqi_plant(point_at(speed, altitude))), dt, method)
-            design = lqi_gain(ad, bd, q, r, where=f"speed {speed:g} m/s, altitude {altitude:g} m")
+            where = f"speed {speed:g} m/s, altitude {altitude:g} m"
+            plant = lqi_plant(point_at(speed, altitude))
+            design = lqi_gain(*discretise(*augment(*plant, integrator_gain), dt, method), q, r, where=where)
             gains[i, j], radius[i, j], residual[i, j] = design.gain, design.spectral_radius, design.residual
-    return Schedule(speeds, altitudes, gains, radius, residual)
+            flown[i, j] = np.abs(np.linalg.eigvals(flown_loop(*plant, design.gain, integrator_gain, dt))).max()
+            if not flown[i, j] < 1.0:  # NaN included
+                raise FlownLoopUnstable(f"LQI design at {where}: the loop as flown (integrator gains "
+                                 f"{tuple(map(float, integrator_gain))}) is not stable, spectral radius "
+                                 f"{flown[i, j]:.9g}")  # fmt: skip
+    return Schedule(speeds, altitudes, gains, radius, residual, flown)
