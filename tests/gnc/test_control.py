@@ -194,7 +194,8 @@ def test_parachutes_trigger_on_the_navigation_solution():
     triggers = (jnp.asarray(jnp.inf), jnp.asarray(jnp.inf))
 
     def tick(state, triggers, t, height, down_mps, moving=True):
-        nav = Navigation(Vec3(0.0, 0.0, -height), Vec3(0.0, 0.0, down_mps), Quat(1.0, 0.0, 0.0, 0.0), Vec3(0.0, 0.0, 0.0))
+        still = Vec3(0.0, 0.0, 0.0)
+        nav = Navigation(Vec3(0.0, 0.0, -height), Vec3(0.0, 0.0, down_mps), Quat(1.0, 0.0, 0.0, 0.0), still)
         return control.sensed_triggers(state, nav, jnp.asarray(moving), jnp.asarray(t), altitudes, triggers)
 
     n = control.APOGEE_DESCENDING_TICKS

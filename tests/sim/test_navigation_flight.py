@@ -227,7 +227,8 @@ def test_the_controller_reads_the_canard_feedback_sensor(thesis):
     ("truth") the controller reads the servos themselves, and the same bias changes no bit."""
     p, traj, (summary, _) = thesis
     _, biased, (biased_summary, _) = flown(headwind(), _with_feedback_bias(p, 1.0))
-    assert abs(float(biased_summary["canard_deflection_rms_rad"]) / float(summary["canard_deflection_rms_rad"]) - 1) > 1e-3
+    rms = "canard_deflection_rms_rad"
+    assert abs(float(biased_summary[rms]) / float(summary[rms]) - 1) > 1e-3
     assert np.abs(np.asarray(biased.body.r_n.z) - np.asarray(traj.body.r_n.z)).max() > 0.01  # [m]
     truth = headwind()
     truth = dataclasses.replace(truth, config=truth.config.model_copy(
@@ -253,8 +254,9 @@ def test_the_main_deploys_at_the_estimated_height():
     raw = tomllib.loads(path.read_text())
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": 0.0, "from_deg": 0.0}}
     raw["dispersions"] = {}
-    raw["avionics"]["gnss"] = {"position_noise_m": [0.0] * 3, "velocity_noise_mps": [0.0] * 3, "sinusoid_frequency_hz": 0.0,
-                               "sinusoid_amplitude_m": [0.0, 0.0, GNSS_OFFSET_M], "sinusoid_phase_deg": [0.0, 0.0, 90.0]}  # fmt: skip
+    raw["avionics"]["gnss"] = {"position_noise_m": [0.0] * 3, "velocity_noise_mps": [0.0] * 3,
+                               "sinusoid_frequency_hz": 0.0, "sinusoid_amplitude_m": [0.0, 0.0, GNSS_OFFSET_M],
+                               "sinusoid_phase_deg": [0.0, 0.0, 90.0]}  # fmt: skip
     campaign = campaign_from_dict(raw, path.parent)
     p = nominal_params(campaign)
     main = [i for i, chute in enumerate(p.rocket.parachutes) if np.isfinite(float(chute.trigger_altitude_agl_m))][0]

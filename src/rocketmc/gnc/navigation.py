@@ -85,8 +85,8 @@ class FilterParams:
     field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
     ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
     the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD and whose
-    gyroscope samples the bias (0: from the rail, zero bias; static); horizontal_only: GNSS updates of north and east only (static); barometer: the
-    barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
+    gyroscope samples the bias (0: from the rail, zero bias; static); horizontal_only: GNSS updates of north and
+    east only (static); barometer: the barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
     magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off; static)."""
 
     attitude: AttitudeTuning
@@ -275,8 +275,9 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     rejected = state.rejected + jnp.stack([m.field_fresh & ~field_ok, fix & ~gnss_ok, use & ~height_ok], axis=-1)
 
     omega_measured_b = tree_where(m.omega_valid, m.omega_b, Vec3(0.0, 0.0, 0.0))
-    new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_rate_b, pad_rate_count,
-                      pad_pressure_sum, pad_pressure_count, pad_ticks, state.failed, state.errors, rejected)  # fmt: skip
+    new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_rate_b,
+                      pad_rate_count, pad_pressure_sum, pad_pressure_count, pad_ticks, state.failed, state.errors,
+                      rejected)  # fmt: skip
     failing = ~_covariance_ok(new)
     new = tree_where(idle | state.failed | failing, dataclasses.replace(state, t=t), new)  # the last good estimates
     new = dataclasses.replace(new, failed=state.failed | failing)
