@@ -166,7 +166,8 @@ def test_help_matches_the_readme(capsys):
     added without the README saying so fails) and the same choices where the README lists them."""
     documented = _readme_commands()
     assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
-                               ("sensors", "simulate"), ("navigate",), ("fly",), ("validate",), ("bench",)}  # fmt: skip
+                               ("sensors", "simulate"), ("navigate",), ("fly",), ("validate",), ("bench",),
+                               ("budget",)}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]
@@ -252,6 +253,25 @@ def test_fly_bad_input_exit_2(tmp_path, capsys):
     assert len(lines) == 3 and all(line.startswith("rocketmc: error:") for line in lines), lines
     assert "--realization 1000" in lines[0] and "(0 to 999)" in lines[0]
     assert "--out" in lines[1] and ".csv or .h5" in lines[1] and "--kml" in lines[2]
+    assert not list(tmp_path.iterdir())
+
+
+def test_budget_bad_input_exit_2(tmp_path, capsys):
+    """`budget` refuses, in one line and before any flight or file, a campaign without [gnc], one on perfect
+    navigation, too few realizations for an ellipse, an unknown source and a figure it cannot write."""
+    gnc = str(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")
+    assert main(["budget", str(CAMPAIGNS / "lynx_ballistic.toml"), "--plot", str(tmp_path / "b.png")]) == 2
+    assert main(["budget", str(CAMPAIGNS / "lynx_ballistic_ctrl_1s.toml"), "--plot", str(tmp_path / "b.png")]) == 2
+    assert main(["budget", gnc, "-n", "9", "--plot", str(tmp_path / "b.png")]) == 2
+    assert main(["budget", gnc, "-n", "16", "--sources", "gyroscope,compass"]) == 2
+    assert main(["budget", gnc, "-n", "16", "--plot", str(tmp_path / "budget.txt")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 5 and all(line.startswith("rocketmc: error:") for line in lines), lines
+    assert "lynx_ballistic.toml: no [gnc] section" in lines[0]
+    assert "gnc.navigation is 'truth'" in lines[1]
+    assert "9 realizations: the ellipses need at least 10" in lines[2]
+    assert "unknown source(s) compass" in lines[3] and "gyroscope" in lines[3]
+    assert "--plot" in lines[4] and ".png" in lines[4]
     assert not list(tmp_path.iterdir())
 
 

@@ -2,7 +2,7 @@
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
 a campaign, ``sensors simulate``: one realization's sensor log, ``navigate``: the navigation filters replayed on
 a sensor log, ``fly``: one flight's time series, ``validate`` the simulation against a real flight, ``bench`` this
-machine."""
+machine, ``budget``: the GNC error budget of a closed-loop campaign."""
 
 from __future__ import annotations
 
@@ -50,7 +50,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     from .analysis.ellipse import AreaConvergence
     from .analysis.flight_record import write_trajectories
     from .campaign import ResultWriter
-    from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings, stability_warnings
+    from .campaign.checks import VALIDITY_OUTPUTS, calibration_warnings, outputs_validity_warnings, stability_warnings
     from .campaign.runner import chunking
 
     cfg = campaign.config
@@ -65,7 +65,7 @@ def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
     if writer.already_complete:
         print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
         return 0
-    warnings = stability_warnings(campaign)
+    warnings = stability_warnings(campaign) + calibration_warnings(campaign)
     _warn(warnings)
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
@@ -162,6 +162,7 @@ def _warn(lines: list[str]) -> None:
 
 def _report(args) -> int:
     from .analysis import format_summary, load_run, plot_impacts, summarize
+    from .analysis.results import navigation_warnings
     from .analysis.export import MAP_SUFFIXES, write_map
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
@@ -172,6 +173,7 @@ def _report(args) -> int:
         raise RocketmcError(f"--plot-dir {plots}: expected a folder, or a new one's name in an existing folder")
     run = load_run(args.file)
     summary = summarize(run)
+    _warn(navigation_warnings(run))
     from .analysis.safety import format_outside, outside_polygon, outside_radius, read_polygon
 
     if args.outside_radius is not None:
@@ -212,6 +214,7 @@ def _compare(args) -> int:
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     runs = [(file, load_run(file)) for file in args.files]
     comparison = compare(runs)
+    _warn(comparison["warnings"])
     print(json.dumps(comparison, indent=2, allow_nan=False) if args.json else format_comparison(comparison))
     if plot:
         plot_comparison(runs, path=plot)
@@ -540,6 +543,33 @@ def _validate(args) -> int:
     return 0 if all(c.passed is not False for c in checks) else 1
 
 
+def _budget(args) -> int:
+    from .analysis.budget import BudgetError, budget_rows, fly_rows, format_budget, plot_budget, summarize_budget
+
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model)
+    sources = None if args.sources is None else [name for name in args.sources.split(",") if name]
+    try:
+        rows = budget_rows(campaign, sources)
+    except BudgetError as e:
+        raise RocketmcError(f"{args.campaign}: {e}") from None
+    cfg = campaign.config
+
+    def log(message):
+        if not args.quiet:
+            print(message, file=sys.stderr, flush=True)
+
+    flown = sum(row.campaign is not None for row in rows)
+    log(f"{cfg.name}: error budget, {flown} rows of {cfg.n_realizations} realizations, seed {cfg.seed} (one "
+        "compilation per row)")  # fmt: skip
+    summary = summarize_budget(campaign, fly_rows(rows, log))
+    print(json.dumps(summary, indent=2, allow_nan=False) if args.json else format_budget(summary))
+    if plot:
+        plot_budget(summary, plot)
+        print(f"wrote {plot}", file=sys.stderr)
+    return 0
+
+
 def _bench(args) -> int:
     from .bench import DEFAULT_CAMPAIGN, BenchError, format_report, run_benchmarks
     from .campaign import ConfigError
@@ -705,6 +735,25 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--plot-dir", "--plot", dest="plot_dir", metavar="DIR",
                           help="folder for the overlay plots (roccaraso-2021; --plot: its old spelling)")  # fmt: skip
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    budget = commands.add_parser(
+        "budget", help="the GNC error budget: a closed-loop campaign flown with each navigation error source alone",
+        description="Fly a closed-loop campaign (navigation 'filters' or 'sensors') with each navigation error source "
+        "alone, with all (the campaign), with none (the navigation on perfect sensors), on perfect navigation and "
+        "with the controller off, every row with the same seed and N (the same winds and draws): the 95 %% landing "
+        "ellipse of each row, its paired ratios to the others, the navigation and control errors and the failed "
+        "flights. One compilation per row flown; no result file.",
+    )  # fmt: skip
+    budget.add_argument("campaign", help="campaign file (TOML) with [gnc] navigation 'filters' or 'sensors'")
+    budget.add_argument("-n", type=int, help="number of realizations (overrides the campaign)")
+    budget.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
+    budget.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
+                        help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    budget.add_argument("--sources", metavar="NAME,...",
+                        help="the error sources flown alone, separated by commas (default: all of them: "
+                             "accelerometer, gyroscope, magnetometer, barometer, gnss, canard_feedback)")  # fmt: skip
+    budget.add_argument("--json", action="store_true", help="print the budget as JSON")
+    budget.add_argument("--plot", help="write a bar chart of each row's ellipse area to this PNG")
+    budget.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     bench = commands.add_parser(
         "bench", help="measure this machine: flights/s, compile time, peak memory, float32 against float64",
         description="Fly a campaign for each N, aerodynamic model and precision, each in a fresh process: "
@@ -760,7 +809,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.barometer_max_mach is not None and not 0 < args.barometer_max_mach < float("inf"):
             parser.error("--barometer-max-mach must be a positive Mach number")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
-               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench}  # fmt: skip
+               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

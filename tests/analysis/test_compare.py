@@ -226,3 +226,26 @@ def test_cli_errors_are_one_line(write, tmp_path, capsys, case, needle):
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
     assert err.startswith("rocketmc: error: ") and err.count("\n") == 1 and needle.format(tmp_path) in err, err
+
+
+def test_diverged_navigation_is_counted_and_warned(write, tmp_path, capsys):
+    """A run whose flights' navigation diverged: its count in the comparison, a warning line in the table and on
+    stderr naming the file; the baseline without the flag has none."""
+    from rocketmc.analysis.results import DIVERGED
+
+    north, east = _impacts()
+    a = write("a.h5", north, east)
+    b = str(tmp_path / "b.h5")
+    writer = ResultWriter(b, load_campaign(CAMPAIGNS / "lynx_ballistic.toml").with_overrides(n_realizations=N, seed=1), N)
+    flag = np.zeros(N)
+    flag[:5] = 1.0
+    outputs = {"status": np.zeros(N, dtype=np.int32), "impact_north_m": north, "impact_east_m": east, DIVERGED: flag}
+    writer.write(ChunkResult(0, outputs, {}, 0.0), 0)
+    writer.finish()
+    result = compare([(a, load_run(a)), (b, load_run(b))])
+    assert [r["navigation_diverged"] for r in result["runs"]] == [0, 5]
+    (line,) = result["warnings"]
+    assert line.startswith(f"{b}: ") and "diverged in 5 of 200 flights" in line
+    assert main(["compare", a, b]) == 0
+    out, err = capsys.readouterr()
+    assert f"Warning: {line}" in out and err == f"rocketmc: warning: {line}\n"

@@ -76,7 +76,7 @@ def _write(path, outputs, inputs, complete=True, with_outputs=True):
                     ds.attrs["unit"] = "1"
                     ds.attrs["codes"] = json.dumps(CODES)
                 else:
-                    ds.attrs["unit"] = UNITS[name]
+                    ds.attrs["unit"] = {**UNITS, "navigation_diverged": "1"}[name]
         g = f.create_group("inputs")
         for name, values in inputs.items():
             g.create_dataset(name, data=values)
@@ -254,3 +254,42 @@ def test_ellipse_coverage_is_the_mahalanobis_fraction(tmp_path):
     d2 = np.einsum("in,ij,jn->n", d, np.linalg.inv(np.cov(points)), d)
     for e in summarize(run)["impact_ellipses"]:
         assert e["coverage"] == pytest.approx(np.mean(d2 <= chi2.ppf(e["level"], 2)), abs=1.5 / points.shape[1])  # a point on the boundary may round either way
+
+
+def _with_diverged(tmp_path, diverged_rows):
+    """The synthetic run with a ``navigation_diverged`` output, 1 at ``diverged_rows``: its path."""
+    outputs, inputs = _synthetic()
+    outputs["navigation_diverged"] = np.zeros(N)
+    outputs["navigation_diverged"][diverged_rows] = 1.0
+    path = tmp_path / "nav.h5"
+    _write(path, outputs, inputs)
+    return path
+
+
+def test_diverged_navigation_is_counted_and_warned(tmp_path, capsys):
+    """Flights whose navigation diverged are counted over every status (rows 3 and 200 failed, 7 and 8 ok) and
+    warned of in the summary, its text and, from ``rocketmc report``, on stderr; the ok ones stay in the ellipse."""
+    from rocketmc.cli import main
+
+    path = _with_diverged(tmp_path, [3, 7, 8, 200])
+    summary = summarize(load_run(path))
+    assert summary["navigation_diverged"] == 4
+    assert summary["impact_ellipses"][0]["n"] == N - 4  # the ok diverged flights are kept
+    (line,) = [w for w in summary["warnings"] if "diverged" in w]
+    assert "diverged in 4 of 400 flights" in line and "2 of them are in the impact ellipses" in line
+    assert f"Warning: {line}" in format_summary(summary)
+    assert main(["report", str(path)]) == 0
+    assert f"rocketmc: warning: {line}" in capsys.readouterr().err
+
+
+def test_no_diverged_flight_no_warning(tmp_path, capsys):
+    """The flag all 0: counted 0, no warning; a run without the flag (no navigation filters): None."""
+    from rocketmc.cli import main
+
+    summary = summarize(load_run(_with_diverged(tmp_path, [])))
+    assert summary["navigation_diverged"] == 0 and summary["warnings"] == []
+    assert main(["report", str(tmp_path / "nav.h5")]) == 0
+    assert "warning" not in capsys.readouterr().err
+    outputs, inputs = _synthetic()
+    _write(tmp_path / "plain.h5", outputs, inputs)
+    assert summarize(load_run(tmp_path / "plain.h5"))["navigation_diverged"] is None

@@ -68,3 +68,26 @@ def test_the_flights_maxima_and_outside_count_from_their_outputs(lynx):
                                              "max_dynamic_pressure_pa": [4e4, 4e4, 4e4],
                                              "max_dynamic_pressure_outside_aero_tables_pa": [5e3, 1e2, 2e4]})  # fmt: skip
     assert any("Mach 0.95" in line for line in lines) and any(": 2 flight(s) left" in line for line in lines), lines
+
+
+@pytest.mark.parametrize("avionics, navigation, warned", [
+    ({"part": "bmx160_uncalibrated"}, "filters", ["magnetometer", "gyroscope"]),
+    ({"part": "bmx160_uncalibrated", "magnetometer": {"part": "lis3mdl"}}, "filters", ["gyroscope"]),
+    ({"part": "bmx160", "magnetometer": {"part": "bmx160", "hard_iron_std": 40.0}}, "filters", ["magnetometer"]),
+    ({"part": "bmx160"}, "filters", []),
+    ({"part": "lis3mdl_uncalibrated"}, "filters", ["magnetometer"]),
+    ({"part": "thesis"}, "filters", []),
+    ({"part": "bmx160_uncalibrated"}, "sensors", []),  # no filters to diverge
+    ({"part": "bmx160_uncalibrated", "truth_only": True}, "filters", []),
+])  # fmt: skip
+def test_filters_on_uncalibrated_parts_are_warned(avionics, navigation, warned):
+    """The navigation filters on an uncalibrated magnetometer (the BMX160's 40 µT, the LIS3MDL's 100 µT, or a
+    calibrated part's 2 µT with 40 µT of hard iron beside it) or gyroscope (3 deg/s): one line per sensor; the
+    calibrated parts (2 µT, 0.2 deg/s), the thesis's and raw-sensor navigation: none."""
+    from rocketmc.campaign.checks import calibration_warnings
+
+    raw = tomllib.loads((CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text())
+    raw = {**raw, "gnc": {**raw["gnc"], "navigation": navigation}, "avionics": avionics, "dispersions": {}}
+    lines = calibration_warnings(campaign_from_dict(raw, CAMPAIGNS))
+    assert [line.split("uncalibrated ")[1].split(" ")[0] for line in lines] == warned, lines
+    assert all("navigation_diverged" in line for line in lines)

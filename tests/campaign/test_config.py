@@ -31,12 +31,13 @@ DEFAULTS = {
     "rocket.geometry.canards.cant_deg": 0.0, "rocket.geometry.canards.first_panel_deg": 0.0,
     "rocket.parachutes.*.opening_time_s": 0.0, "environment.wind.speed_scale": 1.0,
     "environment.atmosphere.wind_rotation_deg": 0.0, "environment.atmosphere.wind_scale": 1.0,
+    "environment.magnetic_field.anomaly_nt.*": 0.0,
 }  # fmt: skip
 PARTS = ROCKETS.parent / "sensors"
 SENSOR_DEFAULTS = {
     "bias.*": 0.0, "bias_std.*": 0.0, "bias_walk": 0.0, "scale_factor.*": 0.0, "scale_factor_std": 0.0, "cross_axis.*": 0.0,
     "cross_axis_std": 0.0, "misalignment_deg.*": 0.0, "misalignment_std_deg": 0.0, "mounting_deg.*": 0.0,
-    "hard_iron.*": 0.0, "hard_iron_std": 0.0, "latency_s": 0.0, "sinusoid_amplitude_m.*": 0.0,
+    "hard_iron.*": 0.0, "hard_iron_std": 0.0, "soft_iron_std": 0.0, "latency_s": 0.0, "sinusoid_amplitude_m.*": 0.0,
     "sinusoid_frequency_hz": 0.0, "sinusoid_phase_deg.*": 0.0, "first_fix_s": 0.0, "vibration_per_kpa.*": 0.0,
 }  # fmt: skip
 """Numbers a sensor's part and table may leave out (by the field's path in the sensor's table) and their defaults;

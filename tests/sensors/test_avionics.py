@@ -102,9 +102,9 @@ def test_the_accelerometer_sees_the_lever_arm_terms():
 
 
 def test_the_drawn_errors_are_the_parts_and_stay_put():
-    # BMX160 gyro: turn-on bias ~ N(0, 3 deg/s) per axis, drawn per flight; noise 0.007 deg/s/√Hz at 50 Hz
-    campaign, _, bus = static_bus({"part": "bmx160", "barometer": {"part": "ms5803_01ba"}, "gnss": {"part": "neo_m9n"}},
-                                  20.0, realization=3)  # fmt: skip
+    # BMX160 gyro, uncalibrated: turn-on bias ~ N(0, 3 deg/s) per axis, drawn per flight; noise 0.007 deg/s/√Hz at 50 Hz
+    parts = {"part": "bmx160_uncalibrated", "barometer": {"part": "ms5803_01ba_uncalibrated"}, "gnss": {"part": "neo_m9n"}}
+    campaign, _, bus = static_bus(parts, 20.0, realization=3)
     drawn = realization_params(campaign, jax.random.key(campaign.config.seed), np.uint32(3))[1]
     bias = np.radians([float(drawn[f"avionics.gyroscope.bias.{i}"]) for i in range(3)])
     gyro = bus.gyroscope.value

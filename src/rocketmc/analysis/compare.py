@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import RocketmcError
 from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
-from .results import Run, _table
+from .results import Run, _table, navigation_warnings
 
 LEVEL = 0.95
 """Confidence level of the compared ellipses (the one ``report`` gives bootstrap intervals for)."""
@@ -25,7 +25,8 @@ class CompareError(RocketmcError, ValueError):
 def dispersion(run: Run, level: float = LEVEL) -> dict:
     """The ``level`` impact ellipse of ``run``'s ok flights (``Ellipse.to_dict()``, metres) with the
     bootstrap intervals of its area [m²] and centre [m] (``bootstrap_intervals``): keys
-    ``campaign_name, seed, n_realizations, n_ok, ellipse, intervals``."""
+    ``campaign_name, seed, n_realizations, n_ok, ellipse, intervals`` and ``navigation_diverged``, the flights of
+    any status whose navigation estimate diverged (``Run.diverged``; they stay in the ellipse)."""
     north, east = run.ok_impacts()
     _enough(north.size, "ok flight(s) with an impact point")
     return {
@@ -35,6 +36,7 @@ def dispersion(run: Run, level: float = LEVEL) -> dict:
         "n_ok": int(north.size),
         "ellipse": confidence_ellipse(north, east, level).to_dict(),
         "intervals": bootstrap_intervals(north, east, level),
+        "navigation_diverged": int(run.diverged.sum()),
     }
 
 
@@ -76,10 +78,12 @@ def area_ratio(baseline: Run, other: Run, level: float = LEVEL) -> dict:
 
 def compare(runs: Sequence[tuple[str, Run]], level: float = LEVEL) -> dict:
     """Each run ``(file name, run)``'s :func:`dispersion`, then each later run's :func:`area_ratio`
-    to the first: ``{"level", "runs": [{"file", ...}], "ratios": [{"file", "baseline", ...}]}``."""
+    to the first, and each run's ``navigation_warnings`` prefixed with its file name: ``{"level", "runs":
+    [{"file", ...}], "ratios": [{"file", "baseline", ...}], "warnings"}``."""
     (base_file, baseline), others = runs[0], runs[1:]
     return {
         "level": level,
+        "warnings": [f"{file}: {line}" for file, run in runs for line in navigation_warnings(run)],
         "runs": [{"file": file, **_naming(file, dispersion, run, level)} for file, run in runs],
         "ratios": [{"file": file, "baseline": base_file,
                     **_naming(f"{file} against {base_file}", area_ratio, baseline, run, level)}
@@ -133,4 +137,5 @@ def format_comparison(comparison: dict) -> str:
             ],  # fmt: skip
             align="llrrrr",
         )
+    out += [f"Warning: {line}" for line in comparison["warnings"]]
     return "\n".join(out)

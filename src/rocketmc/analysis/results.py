@@ -29,6 +29,9 @@ SUMMARY_LEVELS = (0.5, 0.95, 0.99)
 _PERCENTILES = {"p5": 5.0, "p50": 50.0, "p95": 95.0}
 REQUIRED_OUTPUTS = ("status", "impact_north_m", "impact_east_m")
 """Datasets every result file has (docs/conventions.md) and the report reads."""
+DIVERGED = "navigation_diverged"
+"""The per-flight flag of a navigation estimate that diverged (``sim.flight.NAVIGATION_METRICS``; flights on the
+navigation filters only)."""
 
 
 class ResultFileError(RocketmcError, ValueError):
@@ -65,6 +68,14 @@ class Run:
         """Boolean mask of realizations, of any status, with finite impact coordinates (a tumbled flight
         still lands; one stopped on a NaN state has no impact point)."""
         return np.isfinite(self._impacts()).all(axis=0)
+
+    @property
+    def diverged(self) -> np.ndarray:
+        """Boolean mask of realizations, of any status, whose navigation estimate diverged (all False in a run
+        without the flag: no navigation filters)."""
+        if DIVERGED not in self.outputs:
+            return np.zeros(len(self.outputs), dtype=bool)
+        return self.outputs[DIVERGED].to_numpy(dtype=float) > 0.5
 
     def _impacts(self) -> np.ndarray:
         """(2, N) impact points (north, east) [m] of every realization."""
@@ -179,6 +190,19 @@ def load_trajectories(path: str | Path) -> dict[int, pd.DataFrame]:
         return trajectories
 
 
+def navigation_warnings(run: Run) -> list[str]:
+    """One line if any flight's navigation estimate diverged (``Run.diverged``): how many, and that the ellipse,
+    drawn from the ok flights, keeps them (they flew so); none otherwise."""
+    diverged = run.diverged
+    if not diverged.any():
+        return []
+    landed = int((diverged & run.landed).sum())
+    return [f"{run.attrs.get('campaign_name', '')}: the navigation estimate diverged in {int(diverged.sum())} of "
+            f"{len(diverged)} flights (/outputs/{DIVERGED}: attitude, velocity or NEES beyond its bound, "
+            f"docs/navigation.md); {landed} of them are in the impact ellipses, which show the broken navigation's "
+            "dispersion, not a working one's"]  # fmt: skip
+
+
 def _stat(x: float) -> float | None:
     """Float, with NaN/inf mapped to None (strict JSON has no NaN)."""
     return float(x) if math.isfinite(x) else None
@@ -211,9 +235,11 @@ def summarize(run: Run) -> dict:
     mean, std (ddof=1), min, p5, p50, p95, max) and ``impact_ellipses`` (``Ellipse.to_dict()``
     at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
     ``impact_ellipse_95_intervals`` (``bootstrap_intervals`` of the 95 % ellipse's area and centre;
-    None below ``MIN_BOOTSTRAP_POINTS``) and ``warnings`` (what ``run`` warned of: the nominal rocket's static
-    stability, flights beyond the aerodynamic method's validity; the file's ``warnings`` attribute) and
-    ``trajectories`` (the realizations whose trajectories the file keeps, ascending).
+    None below ``MIN_BOOTSTRAP_POINTS``) and ``navigation_diverged`` (flights of any status whose navigation
+    estimate diverged, ``Run.diverged``; None without navigation filters) and ``warnings`` (what ``run`` warned of:
+    the nominal rocket's static stability, flights beyond the aerodynamic method's validity, the file's
+    ``warnings`` attribute; then ``navigation_warnings``) and ``trajectories`` (the realizations whose trajectories
+    the file keeps, ascending).
     """
     ok = run.ok
     status = run.outputs["status"].to_numpy()
@@ -256,7 +282,8 @@ def summarize(run: Run) -> dict:
         "metrics": metrics,
         "impact_ellipses": ellipses,
         "impact_ellipse_95_intervals": intervals,
-        "warnings": json.loads(run.attrs.get("warnings", "[]")),
+        "navigation_diverged": int(run.diverged.sum()) if DIVERGED in run.outputs else None,
+        "warnings": json.loads(run.attrs.get("warnings", "[]")) + navigation_warnings(run),
         "trajectories": list(run.trajectories),
     }
 

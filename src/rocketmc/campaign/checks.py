@@ -1,7 +1,7 @@
 """Checks of a campaign before and after flying that warn rather than refuse: a nominal rocket that is
-statically unstable (someone may fly one on purpose, to see where it lands) and flights beyond the range
-of the aerodynamic tables or of the method that built them. Each returns the warning lines (none: all is
-well), for ``run``, ``fly`` and ``report`` alike."""
+statically unstable (someone may fly one on purpose, to see where it lands), navigation filters on an uncalibrated
+magnetometer or gyroscope, and flights beyond the range of the aerodynamic tables or of the method that built them.
+Each returns the warning lines (none: all is well), for ``run``, ``fly`` and ``report`` alike."""
 
 from __future__ import annotations
 
@@ -46,6 +46,39 @@ def stability_warnings(campaign: Campaign, mach: float = MARGIN_MACH) -> list[st
         f"calibers at Mach {mach:g} (centre of pressure ahead of the centre of mass)"
         for when, margin in nominal_static_margins(campaign, mach).items()
         if not margin >= 0
+    ]
+
+
+UNCALIBRATED_FIELD_OFFSET_UT = 10.0
+"""A magnetometer whose per-flight offset spread (sensor bias and hard iron together, per axis) exceeds this is
+uncalibrated: 5x what an ellipsoid fit leaves (2 µT, data/sensors/SOURCE.md), a quarter of the BMX160's raw 40 µT;
+10 µT on each axis (17 µT) of a ~47 µT field turns its direction by up to 22°, beyond the 10° of a diverged estimate
+(``gnc.navigation.DIVERGED_ATTITUDE_RAD``)."""
+UNCALIBRATED_GYRO_BIAS_DEG_S = 1.0
+"""A gyroscope whose per-flight bias spread exceeds this [deg/s, per axis] is uncalibrated: 5x what averaging on the
+pad leaves (0.2 deg/s), a third of the BMX160's raw 3 deg/s; 1 deg/s over a 10 s window is 10° of attitude."""
+
+
+def calibration_warnings(campaign: Campaign) -> list[str]:
+    """One line per sensor the navigation filters read whose per-flight offset spread is an uncalibrated part's:
+    the magnetometer above ``UNCALIBRATED_FIELD_OFFSET_UT``, the gyroscope above ``UNCALIBRATED_GYRO_BIAS_DEG_S``
+    (none without [gnc] navigation = "filters", or for a truth-only sensor)."""
+    cfg = campaign.config
+    if cfg.gnc is None or cfg.gnc.navigation != "filters" or cfg.avionics is None:
+        return []
+    mag, gyro = cfg.avionics.magnetometer, cfg.avionics.gyroscope
+    spreads = {
+        "magnetometer": (mag, math.hypot(max(mag.bias_std), mag.hard_iron_std), UNCALIBRATED_FIELD_OFFSET_UT, "µT",
+                         "an ellipsoid fit in the airframe leaves ~2 µT"),
+        "gyroscope": (gyro, max(gyro.bias_std), UNCALIBRATED_GYRO_BIAS_DEG_S, "deg/s",
+                      "averaging it on the pad leaves ~0.2 deg/s"),
+    }  # fmt: skip
+    return [
+        f"{cfg.name}: the navigation filters read an uncalibrated {sensor} (part {config.part!r}: its per-flight offset "
+        f"spread {spread:.3g} {unit} exceeds {limit:g} {unit}; {calibrated}): expect its estimate to diverge "
+        f"(/outputs/navigation_diverged); the calibrated parts are docs/sensors.md's"
+        for sensor, (config, spread, limit, unit, calibrated) in spreads.items()
+        if not config.truth_only and spread > limit
     ]
 
 

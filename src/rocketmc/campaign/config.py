@@ -11,7 +11,8 @@ import dataclasses
 import hashlib
 import math
 import tomllib
-from datetime import datetime, timezone
+from collections.abc import Mapping
+from datetime import date, datetime, timezone
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
@@ -26,6 +27,7 @@ from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_incre
 from ..aero.tables import AeroTables
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
+from ..env.magnetic import igrf_validity
 from ..errors import RocketmcError
 from ..gnc.design import Schedule
 from ..env.weather import Weather, WeatherError, read_weather
@@ -83,6 +85,8 @@ MAX_GUIDANCE_GAIN = 1000.0  # guidance [1/s] and integrator [-] gains: 200 × th
 MAX_SENSOR_VALUE = 1e7  # any sensor's unit (m/s², deg/s, µT, Pa, deg): 1e7 Pa is 100 atmospheres
 MAX_SENSOR_LATENCY_S = 1.0  # a sensor later than a second is a logger, not a GNC input
 MAX_MISALIGNMENT_DEG = 10.0  # a sensor more than 10° off its mount is mounted elsewhere
+MAX_ANOMALY_NT = 100_000.0  # twice the main field: the strongest crustal anomalies (iron ores) reach ~tens of µT
+MAX_SOFT_IRON_STD = 0.5  # a soft-iron matrix half off the identity per flight is no calibration
 MAX_LENGTH_KM = 100.0  # GNSS errors: 100 km is no fix
 MAX_LQ_WEIGHT = 1e12  # LQI weights: only their ratios matter, and the DARE loses accuracy beyond 1e12 apart
 DEFAULT_SPEEDS_MPS = [20.0, 30.0, 40.0, 60.0, 80.0, 100.0, 150.0, 200.0, 250.0, 300.0]
@@ -472,14 +476,47 @@ class AtmosphereConfig(_Strict):
         return text
 
 
+class MagneticFieldConfig(_Strict):
+    """The geomagnetic field the magnetometer flies in (docs/sensors.md): the full IGRF-14 at 0 h UTC of ``date``,
+    with its gradient over the flight ("igrf"), or the IGRF-13 dipole at its 2020.0 epoch, constant at the pad's
+    value ("dipole", the thesis's); plus a constant local anomaly (the site's crustal field and the day's
+    variation, which the filters do not know), dispersible per axis."""
+
+    model: Literal["igrf", "dipole"] = Field("igrf", description="the full IGRF-14, or the thesis's IGRF-13 dipole")
+    date: str = Field("2025-01-01", description="the flight's date for the IGRF-14, ISO 8601 ('2025-09-18'), "
+                                                "1900-01-01 to 2030-01-01")  # fmt: skip
+    anomaly_nt: list[Annotated[float, Field(ge=-MAX_ANOMALY_NT, le=MAX_ANOMALY_NT)]] = Field(
+        [0.0, 0.0, 0.0], min_length=3, max_length=3, description="a constant field added to the model's, N, E, D [nT]"
+    )
+
+    @field_validator("date", mode="before")
+    @classmethod
+    def _iso_date(cls, value):
+        """A TOML date (``date = 2025-09-18``) as its ISO text."""
+        return value.isoformat() if isinstance(value, date) else value
+
+    @field_validator("date")
+    @classmethod
+    def _igrf_dates(cls, text: str) -> str:
+        try:
+            day = date.fromisoformat(text)
+        except ValueError:
+            raise ValueError("expected an ISO 8601 date, e.g. '2025-09-18'") from None
+        first, last = igrf_validity()
+        if not first <= day <= last:
+            raise ValueError(f"the IGRF-14 covers {first.isoformat()} to {last.isoformat()}, got {text}")
+        return text
+
+
 class EnvironmentConfig(_Strict):
-    """The air the rocket flies through: mean wind and turbulence."""
+    """The air the rocket flies through: mean wind and turbulence; the geomagnetic field."""
 
     wind: WindConfig = WindConfig()
     turbulence: TurbulenceConfig | None = None
     atmosphere: AtmosphereConfig | None = Field(
         None, description="the day's atmosphere and wind from a file; None: the standard atmosphere and "
                           "[environment.wind]")  # fmt: skip
+    magnetic_field: MagneticFieldConfig = MagneticFieldConfig()
 
     @model_validator(mode="after")
     def _one_wind(self):
@@ -634,6 +671,9 @@ class AttitudeFilterConfig(_Strict):
     initial_attitude_std_deg: StdDeviation = Field(ONE_RAD_DEG, description="initial attitude std per axis (P0)")
     initial_bias_std_deg_s: StdDeviation = Field(ONE_RAD_DEG, description="initial gyro-bias std per axis (P0)")
     field_gate: Gate = Field(None, description="the magnetometer update's χ² innovation gate (none: off)")
+    field_model: Literal["igrf", "dipole"] | None = Field(
+        None, description="the reference field the MEKF carries: the IGRF-14 at environment.magnetic_field.date, or "
+                          "the IGRF-13 dipole (the thesis's); none: environment.magnetic_field.model")  # fmt: skip
 
 
 class PositionFilterConfig(_Strict):
@@ -805,6 +845,9 @@ class MagnetometerConfig(InertialConfig):
     hard_iron: list[SensorValue] = Field(description="the airframe's hard-iron offset per axis [µT]")
     hard_iron_std: SensorSpread = Field(0.0, description="its per-flight spread [µT]")
     soft_iron: list[Annotated[float, Field(ge=-10, le=10)]] = Field(description="soft-iron matrix, row by row [-]")
+    soft_iron_std: Annotated[float, Field(ge=0, le=MAX_SOFT_IRON_STD)] = Field(
+        0.0, description="its per-flight spread, symmetric: the diagonal and upper elements drawn, the lower follow [-]"
+    )
 
     @model_validator(mode="before")
     @classmethod
@@ -855,8 +898,11 @@ SENSOR_CONFIGS: dict[str, type[_SensorConfig]] = {
 }  # fmt: skip
 """Each sensor of the avionics and its schema, in the bus's order."""
 SPREADS = {"bias_std": "bias", "scale_factor_std": "scale_factor", "cross_axis_std": "cross_axis",
-           "misalignment_std_deg": "misalignment_deg", "hard_iron_std": "hard_iron"}  # fmt: skip
+           "misalignment_std_deg": "misalignment_deg", "hard_iron_std": "hard_iron", "soft_iron_std": "soft_iron"}  # fmt: skip
 """A sensor's per-flight spreads and the values they disperse (normal draws about the nominal value)."""
+SPREAD_ELEMENTS = {"soft_iron": (0, 1, 2, 4, 5, 8)}
+"""The elements a spread draws where not all: the soft-iron matrix's diagonal and upper triangle (row by row; the
+lower triangle follows their draws, ``campaign.model``: a symmetric perturbation)."""
 
 
 class AvionicsConfig(_Strict):
@@ -955,13 +1001,15 @@ class Campaign:
     def with_overrides(
         self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
         controller: bool | None = None, sensors: bool | None = None, navigation: str | None = None,
+        values: Mapping[str, object] | None = None,
     ) -> Campaign:  # fmt: skip
         """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
         True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
         (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
         (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
         campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
-        perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match."""
+        perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
+        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above."""
         if navigation is not None:
             sensors = navigation != "truth"
         data = self.config.model_dump()
@@ -976,6 +1024,11 @@ class Campaign:
             current = data["gnc"].get("navigation", "truth")  # a [gnc] just added is empty: the schema's default
             kept = current if current != "truth" else "sensors"
             data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
+        for path, value in (values or {}).items():
+            try:
+                data = _set_path(data, path, value)
+            except (KeyError, IndexError, TypeError, ValueError):
+                raise ConfigError(f"{path}: not a field of this campaign") from None
         config = _validate(data)
         config = _with_sensor_spreads(config)
         campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
@@ -1293,7 +1346,7 @@ def sensor_spreads(config: CampaignConfig) -> dict[str, Dispersion]:
                 continue
             nominal = getattr(values, target)
             for i, std in enumerate(stds if isinstance(stds, list) else [stds] * len(nominal)):
-                if std > 0.0:
+                if std > 0.0 and i in SPREAD_ELEMENTS.get(target, range(len(nominal))):
                     spreads[f"avionics.{sensor}.{target}.{i}"] = Dispersion(dist="normal", std=std)
     return spreads
 

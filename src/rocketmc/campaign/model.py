@@ -7,6 +7,7 @@ traced arrays for the dispersed ones), so every unit conversion below happens pe
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import math
 from collections.abc import Mapping
 
@@ -28,7 +29,7 @@ from ..gnc.navigation import FilterParams
 from ..gnc.position_filter import PositionTuning
 from ..math import Quat, Vec3
 from ..math.table import Table
-from ..env.magnetic import site_field_gradient, site_field_ned
+from ..env.magnetic import igrf_site_field_gradient, site_field_gradient, site_field_ned
 from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
@@ -190,7 +191,8 @@ def nominal_rail(campaign: Campaign) -> tuple[Quat, Vec3]:
 
 def filter_params(campaign: Campaign) -> FilterParams:
     """The navigation filters from the campaign's [gnc.filters] (fixed per campaign; its defaults without a [gnc]
-    section), in SI; the reference field of the site's geomagnetic model and its gradient along NED [T, T/m]."""
+    section), in SI; the reference field of the site's geomagnetic model (``field_model``, by default the
+    environment's) and its gradient along NED [T, T/m]."""
     config = campaign.config
     f, site = (FiltersConfig() if config.gnc is None else config.gnc.filters), config.site
     a, p = f.attitude, f.position
@@ -202,8 +204,10 @@ def filter_params(campaign: Campaign) -> FilterParams:
         Vec3(*map(jnp.asarray, p.gnss_velocity_std_mps)), jnp.asarray(p.altitude_std_m),
         jnp.asarray(p.initial_position_std_m), jnp.asarray(p.initial_velocity_std_mps),
     )  # fmt: skip
+    model = a.field_model or config.environment.magnetic_field.model
     with jax.ensure_compile_time_eval():  # the site's numbers: constants of the flight, even under jit
-        field_t, gradient = site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m)
+        field_t, gradient = (site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m)
+                             if model == "dipole" else _igrf(config))  # fmt: skip
     return FilterParams(attitude, position, jnp.asarray(field_t), jnp.asarray(gradient), jnp.asarray(p.gnss_after_s),
                         f.pad_samples if f.initialisation == "pad" else 0, p.gnss == "horizontal", p.barometer,
                         a.field_gate, p.gnss_gate, p.altitude_gate)  # fmt: skip
@@ -261,7 +265,7 @@ def _avionics(campaign: Campaign, v: Mapping, key, body_x, n_canards: int) -> Av
     """The sensors from the campaign's [avionics] (None without it), from the (possibly drawn) values ``v``; the
     keys of their noise streams ``avionics.<sensor>`` from the realization's ``key``; ``body_x``: a position
     in the rocket's coordinates (dotted path) to body-frame x [m]; no canard feedback without canards."""
-    config, site = campaign.config.avionics, campaign.config.site
+    config = campaign.config.avionics
     if config is None:
         return None
 
@@ -274,9 +278,7 @@ def _avionics(campaign: Campaign, v: Mapping, key, body_x, n_canards: int) -> Av
         return Mounted(_channel(campaign, v, sensor), rotation, position)
 
     m, g = "avionics.magnetometer", "avionics.gnss"
-    with jax.ensure_compile_time_eval():  # the site's numbers: a constant of the flight, even under jit
-        field_t = 1e-9 * site_field_ned(site.latitude_deg, site.longitude_deg, site.altitude_m)
-    magnetometer = Magnetometer(mounted("magnetometer"), jnp.asarray(field_t), _vector(v, f"{m}.soft_iron", 9).reshape(3, 3),
+    magnetometer = Magnetometer(mounted("magnetometer"), *_true_field(campaign, v), _soft_iron(campaign, v),
                                 1e-6 * _vector(v, f"{m}.hard_iron", 3))  # fmt: skip
     fix_noise = jnp.concatenate([_vector(v, f"{g}.position_noise_m", 3), _vector(v, f"{g}.velocity_noise_mps", 3)])
     receiver = Channel(
@@ -289,6 +291,40 @@ def _avionics(campaign: Campaign, v: Mapping, key, body_x, n_canards: int) -> Av
     keys = {name: stream_key(key, f"avionics.{name}") for name in SENSORS}
     return Avionics(mounted("accelerometer"), mounted("gyroscope"), magnetometer, _channel(campaign, v, "barometer"),
                     gnss, _channel(campaign, v, "canard_feedback") if n_canards else None, keys)  # fmt: skip
+
+
+def _igrf(config) -> tuple:
+    """The IGRF-14 field at the site on the campaign's date and its gradient along NED [T, T/m] (numpy)."""
+    site, date = config.site, datetime.date.fromisoformat(config.environment.magnetic_field.date)
+    return igrf_site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m, date)
+
+
+def _true_field(campaign: Campaign, v: Mapping) -> tuple:
+    """The flight's geomagnetic field at the pad [T, NED] and its gradient along NED [T/m] (None: constant, the
+    dipole's) from [environment.magnetic_field], its anomaly from the (possibly drawn) values ``v``."""
+    config, f = campaign.config, "environment.magnetic_field.anomaly_nt"
+    site = config.site
+    with jax.ensure_compile_time_eval():  # the site's numbers: constants of the flight, even under jit
+        if config.environment.magnetic_field.model == "dipole":
+            field_t, gradient = 1e-9 * site_field_ned(site.latitude_deg, site.longitude_deg, site.altitude_m), None
+        else:
+            field_t, gradient = _igrf(config)
+    field_t = jnp.asarray(field_t)
+    if any(campaign.nominal[f"{f}.{i}"] != 0.0 or f"{f}.{i}" in config.dispersions for i in range(3)):
+        field_t = field_t + 1e-9 * _vector(v, f, 3)
+    return field_t, None if gradient is None else jnp.asarray(gradient)
+
+
+def _soft_iron(campaign: Campaign, v: Mapping):
+    """The magnetometer's soft-iron matrix (3, 3) [-] from the (possibly drawn) values ``v``; with a per-flight
+    spread, the lower triangle follows the upper's draws (``config.SPREAD_ELEMENTS``): a symmetric perturbation of
+    the configured matrix."""
+    path = "avionics.magnetometer.soft_iron"
+    matrix = _vector(v, path, 9).reshape(3, 3)
+    if campaign.config.avionics.magnetometer.soft_iron_std == 0.0:
+        return matrix
+    nominal = jnp.asarray([campaign.nominal[f"{path}.{i}"] for i in range(9)]).reshape(3, 3)
+    return matrix + jnp.triu(matrix - nominal, 1).T
 
 
 def _atmosphere(campaign: Campaign) -> AtmosphereProfile | None:

@@ -21,7 +21,7 @@ from .config import DISPERSIBLE_SECTIONS, CampaignConfig, _SensorConfig, fixed_r
 
 UNITS = {
     "_deg_s2": "deg/s²", "_deg_s": "deg/s", "_per_kpa": "unit/kPa", "_kgm2": "kg·m²", "_m2": "m²", "_mps2": "m/s²", "_mps": "m/s", "_kpa": "kPa", "_kg": "kg", "_deg": "deg",
-    "_hz": "Hz", "_s2": "s²", "_s": "s", "_m": "m", "_pa": "Pa", "_n": "N",
+    "_hz": "Hz", "_s2": "s²", "_s": "s", "_m": "m", "_pa": "Pa", "_nt": "nT", "_n": "N",
 }  # fmt: skip
 """Unit of a key from its name's suffix (the project's convention: the unit ends the name), the first that
 matches (so the longer suffixes first); "unit" is the sensor's own (docs/sensors.md)."""

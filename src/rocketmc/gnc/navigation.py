@@ -15,10 +15,12 @@ solution (the thesis fed the a-priori one forward, a tick late). Frames: NED fro
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0, pressure_height_m
+from ..env.magnetic import first_order_field
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass, static_field, tree_where
 from ..sensors.avionics import Avionics, Bus, to_body
@@ -86,8 +88,9 @@ class FilterParams:
     ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
     the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD and whose
     gyroscope samples the bias (0: from the rail, zero bias; static); horizontal_only: GNSS updates of north and
-    east only (static); barometer: the barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
-    magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off; static)."""
+    east only (static); barometer: the barometric height update (static); field_gate, gnss_gate, altitude_gate: the
+    innovation gates of the magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off;
+    static)."""
 
     attitude: AttitudeTuning
     position: PositionTuning
@@ -168,8 +171,7 @@ def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterStat
 
 def _reference_field(params: FilterParams, r_n: Vec3) -> Vec3:
     """The model's geomagnetic field at ``r_n`` [T, NED], to first order from the pad's."""
-    g, r = params.field_gradient, (r_n.x, r_n.y, r_n.z)
-    return Vec3(*(params.field_n[i] + sum(g[i, j] * r[j] for j in range(3)) for i in range(3)))
+    return first_order_field(params.field_n, params.field_gradient, r_n)
 
 
 def innovation_gate(gate: float | None, nis) -> jnp.ndarray:
@@ -233,7 +235,7 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     grow; after ``pad_samples`` ticks there TRIAD sets the attitude and the gyroscope's mean the bias (the rocket is
     at rest: the mean rate is the bias, plus the Earth's rotation, ≤ 7.3e-5 rad/s, which this flat, non-rotating
     Earth does not fly).
-    ``idle`` (a parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
+    ``idle`` (in a flight: every parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
     solution (body rates: the gyroscope's less the estimated bias) and the new state (its ``errors`` untouched:
     ``track_errors``)."""
     dt = t - state.t
@@ -313,14 +315,48 @@ def track_errors(state: FilterState, q_nb: Quat, r_n: Vec3, v_n: Vec3, bias_b: V
     return dataclasses.replace(state, errors=errors)
 
 
-def navigation_summary(state: FilterState) -> dict:
-    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came."""
+DIVERGED_ATTITUDE_RAD = 0.1745329251994330  # 10°
+"""A flight's navigation has diverged when its attitude estimate is further than this from the truth at some tick of
+the controller's active time: 5x the thesis filters' largest window error (median 1.82°, the headwind test's ascent
+4.05°, docs/validation.md); 10° of attitude error tilts the inertial acceleration by 17 % of the thrust's."""
+DIVERGED_VELOCITY_RAD = 0.03490658503988659  # 2°
+"""... or when its velocity error at burnout, over the speed then, exceeds this (an upper bound on the estimated
+flight path's direction error, which guidance steers by): above the controller's own tracking error on perfect
+navigation (χ 1.47° RMS, Lynx), 8x the thesis filters' median (0.25°, at most 0.55° in 128 flights) and above the
+largest of custom_canards' on a gyro-trusting tuning (1.5°), where its ellipse is 1.9x perfect navigation's
+(docs/navigation.md). A fraction, not m/s: the same attitude error makes a faster boost's velocity error larger."""
+DIVERGED_NEES = 60.0
+"""... or when either filter's NEES (6 degrees of freedom) averaged over the controller's active time exceeds this:
+10x its χ² mean of 6, the errors √10 ≈ 3.2 times the filter's own σ throughout the window, so its gates and gains
+trust an estimate that is wrong (the thesis's tuning averages 1e-4 and 0.22, a consistent tuning 6)."""
+
+DIVERGED_MEANING = (
+    f"1: the navigation estimate diverged (attitude error above {math.degrees(DIVERGED_ATTITUDE_RAD):g}° in the "
+    f"controller's active time, velocity error at burnout above {math.degrees(DIVERGED_VELOCITY_RAD):g}° of the speed "
+    f"then, or a filter's NEES averaged over that time above {DIVERGED_NEES:g}); 0: it did not. Kept in the ellipse: "
+    "the flight flew so"
+)
+"""``navigation_diverged``'s meaning (``sim.flight.NAVIGATION_METRICS``)."""
+
+
+def navigation_diverged(summary: dict, burnout_speed_mps) -> jnp.ndarray:
+    """1.0 where ``navigation_summary``'s errors exceed ``DIVERGED_ATTITUDE_RAD``, ``DIVERGED_VELOCITY_RAD`` (of the
+    true speed at burnout [m/s]) or ``DIVERGED_NEES``, else 0.0 (a NaN, a span that never came, does not count)."""
+    over = (summary["attitude_error_max_window_rad"] > DIVERGED_ATTITUDE_RAD) \
+        | (summary["velocity_error_burnout_mps"] > DIVERGED_VELOCITY_RAD * burnout_speed_mps) \
+        | (summary["attitude_nees_window"] > DIVERGED_NEES) | (summary["position_nees_window"] > DIVERGED_NEES)  # fmt: skip
+    return over.astype(summary["attitude_nees_window"].dtype)
+
+
+def navigation_summary(state: FilterState, burnout_speed_mps) -> dict:
+    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came, but
+    ``navigation_diverged`` (0 or 1; ``burnout_speed_mps``: the true speed at burnout [m/s], NaN before)."""
     e = state.errors
 
     def mean(total, time):
         return jnp.where(time > 0.0, total / jnp.where(time > 0.0, time, 1.0), jnp.nan)
 
-    return {
+    summary = {
         "attitude_error_rms_window_rad": jnp.sqrt(mean(e.window_attitude_sq, e.window_time)),
         "attitude_error_max_window_rad": jnp.where(e.window_time > 0.0, e.window_attitude_max, jnp.nan),
         "attitude_error_rms_ascent_rad": jnp.sqrt(mean(e.ascent_attitude_sq, e.ascent_time)),
@@ -333,3 +369,4 @@ def navigation_summary(state: FilterState) -> dict:
         "attitude_nees_window": mean(e.window_attitude_nees, e.window_time),
         "position_nees_window": mean(e.window_position_nees, e.window_time),
     }
+    return {**summary, "navigation_diverged": navigation_diverged(summary, burnout_speed_mps)}

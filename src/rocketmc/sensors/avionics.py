@@ -20,6 +20,7 @@ from jax import lax
 from jax.extend.random import threefry2x32_p
 
 from ..env.atmosphere import G0
+from ..env.magnetic import first_order_field
 from ..math import Quat, Vec3
 from ..math.fusion import computed_once
 from ..pytree import pytree_dataclass, static_field
@@ -64,11 +65,13 @@ class Mounted:
 
 @pytree_dataclass
 class Magnetometer:
-    """A magnetometer (``Mounted``) in the site's geomagnetic field field_n (3,) [T, NED], behind the
-    airframe's soft iron (3, 3) and hard iron (3,) [T, sensor frame]."""
+    """A magnetometer (``Mounted``) in the flight's geomagnetic field, field_n (3,) [T, NED] at the pad and
+    field_gradient (3, 3) its derivative along r_n [T/m] (None: the same everywhere), behind the airframe's soft
+    iron (3, 3) and hard iron (3,) [T, sensor frame]."""
 
     sensor: Mounted
     field_n: jnp.ndarray
+    field_gradient: jnp.ndarray | None
     soft_iron: jnp.ndarray
     hard_iron: jnp.ndarray
 
@@ -256,7 +259,9 @@ def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_n
     pressure); enabled: the sensors sample (False in the long descent periods); noise: this tick's row of
     ``avionics_noise``."""
     mag = av.magnetometer
-    field_s = _apply(mag.sensor.rotation, q_nb.rotate_inverse(Vec3(*(mag.field_n[i] for i in range(3)))))
+    field_n = (Vec3(*(mag.field_n[i] for i in range(3))) if mag.field_gradient is None
+               else first_order_field(mag.field_n, mag.field_gradient, r_n))  # fmt: skip
+    field_s = _apply(mag.sensor.rotation, q_nb.rotate_inverse(field_n))
     gnss, fix = av.gnss, jnp.concatenate([r_n.to_array(), v_n.to_array()])
     if not gnss.channel.ideal:  # the slow sinusoidal position bias and its derivative, an error of the receiver
         omega = 2.0 * jnp.pi * gnss.frequency

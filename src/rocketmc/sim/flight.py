@@ -27,7 +27,7 @@ from ..env.atmosphere import MAX_ALTITUDE_M
 from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, sensed_triggers, truth
 from ..gnc.guidance import guidance_active
 from ..gnc.navigation import (
-    bus_measurements, dead_reckoning, filter_step, liftoff_sensed, navigation_summary, track_errors,
+    DIVERGED_MEANING, bus_measurements, dead_reckoning, filter_step, liftoff_sensed, navigation_summary, track_errors,
 )  # fmt: skip
 from ..math import Quat, Vec3, rk4_step
 from ..sensors.avionics import (
@@ -652,6 +652,7 @@ NAVIGATION_METRICS: dict[str, Metric] = {
     "velocity_error_apogee_mps": Metric("m/s", "norm of the velocity estimate's error at the first GNC tick after apogee"),
     "attitude_nees_window": Metric("1", "mean over the controller's active time of the MEKF's normalised estimation error squared (6 dof)"),
     "position_nees_window": Metric("1", "mean over the controller's active time of the position/velocity filter's NEES (6 dof)"),
+    "navigation_diverged": Metric("1", DIVERGED_MEANING),
 }  # fmt: skip
 """The outputs a flight on the navigation filters adds (``gnc.navigation.navigation_summary``); NaN where their span
 never came."""
@@ -702,7 +703,7 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
     if state.gnc is not None:
         summary.update(control_summary(state.gnc))
     if p.gnc is not None and p.gnc.navigation == "filters":
-        summary.update(navigation_summary(state.gnc.navigation))
+        summary.update(navigation_summary(state.gnc.navigation, summary["burnout_speed_mps"]))
         failed = [state.gnc.navigation.failed]
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M

@@ -1,0 +1,152 @@
+"""The GNC error budget (analysis/budget.py, ``rocketmc budget``) on lynx_ballistic_gnc_1s, N = 16.
+
+Cost: each row flown is one compilation (a sensor's ``truth_only`` is static): the module flies five rows (all,
+none, gyroscope alone, truth, off) and one check row (the barometer alone), six compilations, ~1 min each on a
+free core; the CLI test reuses the five (the process keeps them: ``runner.COMPILED_KEPT`` raised here)."""
+
+import json
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rocketmc.analysis.budget import SOURCES, BudgetError, budget, budget_rows, format_budget
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, runner
+from rocketmc.campaign.runner import run_chunks
+from rocketmc.cli import main
+
+CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
+CAMPAIGN = CAMPAIGNS / "lynx_ballistic_gnc_1s.toml"
+N = 16
+SOURCES_FLOWN = ("gyroscope", "barometer", "canard_feedback")
+"""A source the filters read (flown) and two they do not (reported, not flown)."""
+
+
+@pytest.fixture(scope="module")
+def campaign():
+    return load_campaign(CAMPAIGN).with_overrides(n_realizations=N)
+
+
+@pytest.fixture(scope="module")
+def flown(campaign):
+    """(summary, rows by name) of the budget of ``SOURCES_FLOWN`` with the reference rows."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(runner, "COMPILED_KEPT", 8)  # every row's compilation kept, for the module's tests
+        summary, rows = budget(campaign, SOURCES_FLOWN)
+        yield summary, {row.name: row for row in rows}
+
+
+def _flights(campaign) -> dict[str, np.ndarray]:
+    """The outputs of ``campaign``'s flights as ``rocketmc run`` flies them (``run_chunks``), gathered."""
+    chunks = list(run_chunks(campaign))[1:]
+    return {name: np.concatenate([c.outputs[name] for c in chunks]) for name in chunks[0].outputs}
+
+
+def _same_bits(a: dict, b: dict) -> bool:
+    return a.keys() == b.keys() and all(np.array_equal(a[k], b[k], equal_nan=True) for k in a)
+
+
+def test_all_row_is_the_campaign_run_bit_for_bit(campaign, flown):
+    _, rows = flown
+    assert _same_bits(rows["all"].outputs, _flights(campaign))
+
+
+def test_none_row_is_every_sensor_truth_only(campaign, flown):
+    """The 'none' row is the campaign whose file says ``truth_only = true`` in every sensor's table (the same
+    resolved config: the same flights), and flies as the run path flies that config, bit for bit."""
+    _, rows = flown
+    raw = tomllib.loads(CAMPAIGN.read_text())
+    raw["n_realizations"] = N
+    raw["avionics"].update({sensor: {"truth_only": True} for sensor in SOURCES})
+    assert rows["none"].campaign.config.model_dump() == campaign_from_dict(raw, CAMPAIGNS).config.model_dump()
+    overridden = campaign.with_overrides(values={f"avionics.{sensor}.truth_only": True for sensor in SOURCES})
+    assert _same_bits(rows["none"].outputs, _flights(overridden))
+    assert not _same_bits(rows["none"].outputs, rows["all"].outputs)  # the sensors' errors do change the flights
+
+
+def test_a_source_that_is_off_changes_nothing(campaign, flown):
+    """The barometer (its update is off in the filters) and the canard feedback (read by nothing) are reported,
+    not flown; flying the barometer alone (every other sensor off) gives the 'none' row's flights bit for bit."""
+    summary, rows = flown
+    for name in ("barometer", "canard_feedback"):
+        assert rows[name].campaign is None and rows[name].outputs is None
+        assert rows[name].reason == "not read by navigation = 'filters': the same flights as 'none'"
+    others = {f"avionics.{sensor}.truth_only": True for sensor in SOURCES if sensor != "barometer"}
+    assert _same_bits(_flights(campaign.with_overrides(values=others)), rows["none"].outputs)
+    gyroscope = rows["gyroscope"]
+    assert gyroscope.campaign.config.avionics.gyroscope.truth_only is False
+    assert all(getattr(gyroscope.campaign.config.avionics, s).truth_only for s in SOURCES if s != "gyroscope")
+    assert not _same_bits(gyroscope.outputs, rows["none"].outputs)
+
+
+def test_summary(flown):
+    summary, rows = flown
+    assert [r["name"] for r in summary["rows"]] == ["all", "none", *SOURCES_FLOWN, "truth", "off"]
+    by_name = {r["name"]: r for r in summary["rows"]}
+    assert [r["flown"] for r in summary["rows"]] == [True, True, True, False, False, True, True]
+    for name in ("all", "none", "gyroscope", "truth", "off"):
+        row, outputs = by_name[name], rows[name].outputs
+        assert row["n"] == N and row["failed"] == int((outputs["status"] != 0).sum())
+        assert row["ellipse"]["area_m2"] > 0.0
+        for base in ("none", "truth", "off"):
+            ratio = row["ratios"][base]
+            if base == name:
+                assert ratio is None
+                continue
+            expected = row["ellipse"]["area_m2"] / by_name[base]["ellipse"]["area_m2"]
+            if ratio["n_used"] == row["n_landed"] == by_name[base]["n_landed"]:  # the same flights: the plain ratio
+                assert ratio["ratio"] == pytest.approx(expected, rel=1e-9)  # two formulas' rounding: eigenvalues, det
+            assert ratio["interval"][0] <= ratio["ratio"] <= ratio["interval"][1]
+    # navigation metrics where the filters fly, control metrics where the controller does, none where not
+    assert by_name["gyroscope"]["metrics"]["attitude_error_rms_window_rad"]["n"] == N
+    assert "attitude_error_rms_window_rad" not in by_name["truth"]["metrics"]
+    assert by_name["truth"]["metrics"]["tracking_error_rms_rad"]["n"] == N
+    assert by_name["off"]["metrics"] == {}
+    none_error = by_name["none"]["metrics"]["attitude_error_rms_window_rad"]["p50"]
+    assert by_name["gyroscope"]["metrics"]["attitude_error_rms_window_rad"]["p50"] > none_error
+    assert summary["costliest"]["source"] == "gyroscope"  # the only source flown
+    assert summary["costliest"]["ratio"] == by_name["gyroscope"]["ratios"]["none"]["ratio"]
+    text = format_budget(summary)
+    assert "barometer" in text and "not flown: not read by navigation" in text and "costliest source alone: gyroscope" in text
+
+
+def test_cli_json_and_plot(flown, tmp_path, capsys):
+    """`rocketmc budget --json --plot` prints the library's summary (the same rows, bit for bit) and draws it."""
+    summary, _ = flown
+    png = tmp_path / "budget.png"
+    code = main(["budget", str(CAMPAIGN), "-n", str(N), "--sources", ",".join(SOURCES_FLOWN), "--json", "--plot", str(png)])
+    captured = capsys.readouterr()
+    assert code == 0
+    printed = json.loads(captured.out)
+    strip = lambda s: {**s, "rows": [{k: v for k, v in r.items() if k not in ("compile_s", "flight_s")} for r in s["rows"]]}  # noqa: E731
+    assert strip(printed) == strip(summary)
+    assert set(printed) == {"campaign", "n_realizations", "seed", "level", "navigation", "rows", "costliest", "metrics_units"}
+    assert "row 5/5 off: compiled in" in captured.err and f"wrote {png}" in captured.err
+    assert png.stat().st_size > 10_000
+
+
+def test_idle_sources_without_flying(campaign):
+    """A sensor whose errors are off already, or all zero, is reported as perfect; the rows are only built here."""
+    raw = tomllib.loads(CAMPAIGN.read_text())
+    raw["n_realizations"] = N
+    raw["avionics"]["gnss"] = {"truth_only": True}
+    raw["avionics"]["magnetometer"] = {"noise_std": 0.0, "lsb": 0.0, "misalignment_deg": [0.0, 0.0, 0.0]}
+    rows = {row.name: row for row in budget_rows(campaign_from_dict(raw, CAMPAIGNS), ["gnss", "magnetometer"], False)}
+    assert rows["gnss"].reason == "already perfect (truth_only): the same flights as 'none'"
+    assert rows["magnetometer"].reason.startswith("already perfect (no error term")
+    assert [name for name, row in rows.items() if row.campaign is not None] == ["all", "none"]
+    with pytest.raises(BudgetError, match="unknown source"):
+        budget_rows(campaign, ["compass"])
+
+
+def test_values_override(campaign):
+    """``Campaign.with_overrides(values=...)``, the budget's builder: a field set by dotted path and validated; a
+    path through nothing, or to an unknown key, refused in one line."""
+    changed = campaign.with_overrides(values={"avionics.gnss.truth_only": True, "avionics.gyroscope.bias.0": 0.5})
+    assert changed.config.avionics.gnss.truth_only and changed.config.avionics.gyroscope.bias[0] == 0.5
+    assert not campaign.config.avionics.gnss.truth_only and changed.gnc_schedule is campaign.gnc_schedule
+    with pytest.raises(ConfigError, match=r"^rocket\.nothing\.x: not a field of this campaign$"):
+        campaign.with_overrides(values={"rocket.nothing.x": 1.0})
+    with pytest.raises(ConfigError, match=r"avionics\.gnss\.truth_onl: unknown key"):
+        campaign.with_overrides(values={"avionics.gnss.truth_onl": True})
