@@ -434,7 +434,8 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     deflections of the period, ``control_step``, then the accelerometer. start_n: ``rail_start_n(p)``;
     noise: the period's ``StepNoise``; canard_command: open-loop deflections, a function of time [s]
     returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when ``p.gnc`` is set:
-    guidance and control at the period start, the servos' response inside it)."""
+    guidance and control at the period start, the servos' response inside it; navigating from the sensors, the
+    LQI reads the canard feedback and the parachutes trigger on the navigation, ``sensed_recovery``)."""
     period = control_period(p, settings, state)
     sensing = period <= settings.control_dt_s  # the sensors sample in GNC periods only, not in long descent ones
     if p.gnc is None:
