@@ -182,3 +182,34 @@ def test_lanes_bitwise_whatever_the_batch(params):
         b = jax.tree_util.tree_leaves(jax.tree_util.tree_map(lambda x: x[LANES - 1 - i], large))
         for x, y in zip(a, b):
             np.testing.assert_array_equal(x, y)
+
+
+def test_parachutes_trigger_on_the_navigation_solution():
+    """``sensed_triggers``: apogee once the estimated vertical velocity has pointed down for
+    APOGEE_DESCENDING_TICKS consecutive ticks after liftoff (a shorter run of downward noise resets the count;
+    no apogee before liftoff), the drogue (trigger altitude inf) at that tick, the main at the first tick after it
+    whose estimated height is at or below its altitude."""
+    altitudes = (jnp.inf, 350.0)
+    state = control.Recovery(jnp.asarray(0, jnp.int32), jnp.asarray(jnp.inf))
+    triggers = (jnp.asarray(jnp.inf), jnp.asarray(jnp.inf))
+
+    def tick(state, triggers, t, height, down_mps, moving=True):
+        still = Vec3(0.0, 0.0, 0.0)
+        nav = Navigation(Vec3(0.0, 0.0, -height), Vec3(0.0, 0.0, down_mps), Quat(1.0, 0.0, 0.0, 0.0), still)
+        return control.sensed_triggers(state, nav, jnp.asarray(moving), jnp.asarray(t), altitudes, triggers)
+
+    n = control.APOGEE_DESCENDING_TICKS
+    for k in range(2 * n):  # on the pad, a falling estimate: not an apogee before liftoff
+        state, triggers = tick(state, triggers, 0.02 * k, 1.0, 3.0, moving=False)
+    assert int(state.descending_ticks) == 0 and np.isinf(triggers).all()
+    t = 1.0
+    for down in [-50.0] + [1.0] * (n - 1) + [-0.5] + [1.0] * (n - 1):  # climbing, then n − 1 down, a blip up
+        state, triggers = tick(state, triggers, t, 1600.0, down)
+        t += DT
+    assert np.isinf(float(state.apogee_time)) and np.isinf(triggers).all()
+    state, triggers = tick(state, triggers, t, 1600.0, 1.0)  # the n-th consecutive tick down
+    assert float(state.apogee_time) == t and float(triggers[0]) == t and np.isinf(float(triggers[1]))
+    state, triggers = tick(state, triggers, t + DT, 350.5, 20.0)
+    assert np.isinf(float(triggers[1]))
+    state, triggers = tick(state, triggers, t + 2 * DT, 350.0, 20.0)  # at its altitude: the main
+    assert float(triggers[0]) == t and float(triggers[1]) == t + 2 * DT

@@ -22,10 +22,11 @@ import pytest
 
 from rocketmc.campaign.config import campaign_from_dict
 from rocketmc.campaign.model import nominal_params
-from rocketmc.campaign.runner import sim_settings
+from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.gnc.attitude_filter import attitude_error_b
 from rocketmc.gnc.guidance import reference_direction
-from rocketmc.sim.flight import Status, flight_summary, fly
+from rocketmc.sensors.avionics import gyroscope_bias_b
+from rocketmc.sim.flight import Status, flight_summary, fly, initial_state, rail_start_n
 
 from ..conftest import CAMPAIGNS
 
@@ -40,10 +41,12 @@ integrated until the GNSS), and the gyro's held rates shift the attitude, which 
 for its roll about the field line."""
 
 
-def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: dict | None = None):
+def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: dict | None = None,
+             sensors: dict | None = None):
     """lynx_ballistic_gnc_1s under a constant 10 m/s wind from the launch azimuth, nothing dispersed; errors False:
     every sensor truth-only; pad_samples: TRIAD from that many pad ticks, the motor lit 0.2 s after them;
-    magnetometer: fields of its [avionics.magnetometer] table."""
+    magnetometer: fields of its [avionics.magnetometer] table; sensors: [avionics] tables of fields over the thesis
+    part's."""
     path = CAMPAIGNS / "lynx_ballistic_gnc_1s.toml"
     raw = tomllib.loads(path.read_text())
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": 10.0, "from_deg": raw["launch"]["azimuth_deg"]}}
@@ -53,6 +56,7 @@ def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: 
                                 ("accelerometer", "gyroscope", "magnetometer", "barometer", "gnss")})  # fmt: skip
     if magnetometer is not None:
         raw["avionics"]["magnetometer"] = magnetometer
+    raw["avionics"].update(sensors or {})
     if pad_samples is not None:
         raw["gnc"]["filters"] = {"initialisation": "pad", "pad_samples": pad_samples}
         raw["rocket"].setdefault("motor", {})["ignition_delay_s"] = pad_samples * 0.02 + 0.2
@@ -153,20 +157,54 @@ def test_without_sensor_errors_the_estimates_are_the_truth_to_discretisation():
     assert velocity[ascent].max() < TRUTH_ONLY["velocity_mps"]
 
 
-def test_pad_samples_initialise_the_attitude_by_triad():
-    """40 pad ticks (0.8 s), the motor lit 0.2 s later: TRIAD on the mean accelerometer and magnetometer
-    directions replaces the rail's attitude at the 40th tick, with the initial covariance. The thesis's
-    sensors' accelerometer bias (≤ 0.04 m/s² against g: 0.2°), noise averaged over 40 samples and the
-    magnetometer's 0.3° misalignment bound its error to ~0.5°; 1.5° leaves room, and a frame or sign slip in
-    TRIAD is tens of degrees off."""
-    campaign = headwind(pad_samples=40)
+PAD_TICKS = 250
+"""Pad samples of the TRIAD test: 5 s at 50 Hz, the thesis gyro's 0.3 deg/s noise averaged to 0.019 deg/s."""
+
+
+def test_pad_samples_initialise_the_attitude_by_triad_and_the_gyro_bias():
+    """PAD_TICKS pad ticks, the motor lit 0.2 s later: TRIAD on the mean accelerometer and magnetometer
+    directions replaces the rail's attitude at the last of them, with the initial covariance, and the gyroscope's
+    mean rate its bias. The thesis's sensors' accelerometer bias (≤ 0.04 m/s² against g: 0.2°), the averaged noise
+    and the magnetometer's 0.3° misalignment bound the attitude's error to ~0.5°; 1.5° leaves room, and a frame or
+    sign slip in TRIAD is tens of degrees off. The gyroscope's bias walk off (the mean then estimates a constant),
+    each axis of the bias estimate is within 4 σ/√n of the drawn bias (σ the gyro's 0.3 deg/s per sample, n the
+    PAD_TICKS samples at rest; 4 σ: a chance of 6e-5 per axis to fail by noise; its 0.015 deg/s LSB is dithered by
+    that noise); the rail's initialisation has a zero bias, 0.1 to 0.25 deg/s off."""
+    campaign = headwind(pad_samples=PAD_TICKS, sensors={"gyroscope": {"bias_walk": 0.0}})
     p, traj, (_, status) = flown(campaign)
     assert int(status) == Status.MAX_TIME  # flown 20 s, not to the ground: nothing else failed
     variance = np.asarray(traj.gnc.navigation.attitude.cov[:, 0, 0])
     reset = np.flatnonzero(variance == float(p.gnc.filters.attitude.initial_attitude_std) ** 2)
-    assert len(reset) == 1 and reset[0] == 39  # the 40th period: its start is the 40th tick on the pad
+    assert len(reset) == 1 and reset[0] == PAD_TICKS - 1  # the period whose start is the last tick on the pad
     assert attitude_errors_deg(traj)[1][reset[0] - 1] < 1.5  # the solution at that tick against the truth then
-    assert float(traj.gnc.liftoff_time[-1]) > 40 * 0.02  # liftoff sensed after the pad samples
+    assert float(traj.gnc.liftoff_time[-1]) > PAD_TICKS * 0.02  # liftoff sensed after the pad samples
+    at = lambda tree: jax.tree_util.tree_map(lambda x: x[reset[0]], tree)  # noqa: E731
+    estimate = at(traj.gnc.navigation.attitude.bias_b).to_array()
+    drawn = gyroscope_bias_b(p.avionics, at(traj.avionics)).to_array()
+    tolerance = 4.0 * math.radians(campaign.config.avionics.gyroscope.noise_std) / math.sqrt(PAD_TICKS)
+    assert np.all(np.abs(np.asarray(estimate - drawn)) < tolerance)
+    assert np.abs(np.asarray(drawn)).max() > 2 * tolerance  # a zero estimate fails by far
+
+
+def test_navigation_starts_from_the_nominal_rail_not_the_drawn_one():
+    """A campaign dispersing the rail's elevation (σ 2°) and azimuth (σ 10°): a realization's rail is not the
+    nominal, but its filters (and the raw sensors' dead reckoning) start from the nominal rail's attitude and the
+    nominal rocket's CG on it, which is all the avionics know."""
+    raw = tomllib.loads((CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text())
+    raw["dispersions"] = {"launch.elevation_deg": {"dist": "normal", "std": 2.0, "high": 89.0},
+                          "launch.azimuth_deg": {"dist": "normal", "std": 10.0}}  # fmt: skip
+    nominal = nominal_params(campaign_from_dict(raw, CAMPAIGNS))
+    for navigation in ("filters", "sensors"):
+        raw["gnc"]["navigation"] = navigation
+        campaign = campaign_from_dict(raw, CAMPAIGNS)
+        p, drawn = realization_params(campaign, jax.random.key(campaign.config.seed), 3)
+        assert abs(float(drawn["launch.azimuth_deg"]) - 130.0) > 1.0  # this realization's rail is off the nominal
+        gnc = initial_state(p).gnc.navigation
+        q_nb, r_n = (gnc.attitude.q_nb, gnc.position.r_n) if navigation == "filters" else (gnc.q_nb, gnc.r_n)
+        np.testing.assert_array_equal(np.asarray(q_nb.to_array()), np.asarray(nominal.launch.q_nb0.to_array()))
+        assert float(attitude_error_b(q_nb, p.launch.q_nb0).norm()) > math.radians(1.0)
+        if navigation == "filters":
+            np.testing.assert_array_equal(np.asarray(r_n.to_array()), np.asarray(rail_start_n(nominal).to_array()))
 
 
 def test_a_failed_filter_is_a_status_not_a_crash(thesis):
@@ -178,6 +216,65 @@ def test_a_failed_filter_is_a_status_not_a_crash(thesis):
     _, traj, (summary, status) = flown(headwind(), p)
     assert int(status) == Status.NAVIGATION_FAILED
     assert np.all(np.isfinite(np.asarray(traj.gnc.navigation.attitude.q_nb.w)))
+
+
+def _with_feedback_bias(p, bias_deg: float):
+    """``p`` with a bias of ``bias_deg`` on each fin's canard-feedback sensor."""
+    feedback = p.avionics.canard_feedback
+    feedback = dataclasses.replace(feedback, bias=feedback.bias + math.radians(bias_deg))
+    return dataclasses.replace(p, avionics=dataclasses.replace(p.avionics, canard_feedback=feedback))
+
+
+def test_the_controller_reads_the_canard_feedback_sensor(thesis):
+    """The LQI's actuator states come from the canard-feedback sensor on the bus when it navigates from the sensors:
+    a 1° bias on each fin's feedback changes the filters' flight (its canards, hence its path); on the true state
+    ("truth") the controller reads the servos themselves, and the same bias changes no bit."""
+    p, traj, (summary, _) = thesis
+    _, biased, (biased_summary, _) = flown(headwind(), _with_feedback_bias(p, 1.0))
+    rms = "canard_deflection_rms_rad"
+    assert abs(float(biased_summary[rms]) / float(summary[rms]) - 1) > 1e-3
+    assert np.abs(np.asarray(biased.body.r_n.z) - np.asarray(traj.body.r_n.z)).max() > 0.01  # [m]
+    truth = headwind()
+    truth = dataclasses.replace(truth, config=truth.config.model_copy(
+        update={"gnc": truth.config.gnc.model_copy(update={"navigation": "truth"})}))  # fmt: skip
+    p, traj, (summary, _) = flown(truth)
+    _, biased, (biased_summary, _) = flown(truth, _with_feedback_bias(p, 1.0))
+    for name, value in summary.items():
+        np.testing.assert_array_equal(np.asarray(biased_summary[name]), np.asarray(value), err_msg=name)
+    np.testing.assert_array_equal(np.asarray(biased.body.r_n.z), np.asarray(traj.body.r_n.z))
+
+
+GNSS_OFFSET_M = 100.0
+"""A constant GNSS position error, 100 m down, on the raw sensors' navigation (its height is the GNSS fix's)."""
+
+
+def test_the_main_deploys_at_the_estimated_height():
+    """lynx_nominal_ctrl_1s_sensors (raw-sensor navigation: its height the GNSS fix's), nothing dispersed, no wind,
+    its GNSS exact but for a constant GNSS_OFFSET_M down (the slow sinusoid at 0 Hz, phase 90°): the navigation sees
+    the rocket 100 m lower than it is, so the main (350 m above the pad) triggers at a true 450 m, within the 0.6 m
+    a 20 ms tick descends under the drogue (< 30 m/s); the drogue at the sensed apogee, after the true one. The
+    recorded apogee is the true one."""
+    path = CAMPAIGNS / "lynx_nominal_ctrl_1s_sensors.toml"
+    raw = tomllib.loads(path.read_text())
+    raw["environment"] = {"wind": {"model": "constant", "speed_mps": 0.0, "from_deg": 0.0}}
+    raw["dispersions"] = {}
+    raw["avionics"]["gnss"] = {"position_noise_m": [0.0] * 3, "velocity_noise_mps": [0.0] * 3,
+                               "sinusoid_frequency_hz": 0.0, "sinusoid_amplitude_m": [0.0, 0.0, GNSS_OFFSET_M],
+                               "sinusoid_phase_deg": [0.0, 0.0, 90.0]}  # fmt: skip
+    campaign = campaign_from_dict(raw, path.parent)
+    p = nominal_params(campaign)
+    main = [i for i, chute in enumerate(p.rocket.parachutes) if np.isfinite(float(chute.trigger_altitude_agl_m))][0]
+    record = lambda s: (s.t, -s.body.r_n.z, s.events.chute_trigger_times, s.events.apogee_time)  # noqa: E731
+    run = jax.jit(lambda p: fly(p, sim_settings(campaign), 5000, record=record)[1])  # 100 s: past the main
+    t, height, triggers, apogee = (np.asarray(x) if not isinstance(x, tuple) else tuple(map(np.asarray, x))
+                                   for x in run(p))  # fmt: skip
+    altitude = float(p.rocket.parachutes[main].trigger_altitude_agl_m)
+    k = np.flatnonzero(np.isfinite(triggers[main]))[0]  # the period it triggered at the start of
+    assert triggers[main][k] == t[k - 1]  # a GNC tick: the start of period k, recorded after period k − 1
+    assert abs(height[k - 1] - (altitude + GNSS_OFFSET_M)) < 0.6
+    drogue = 1 - main
+    assert np.isfinite(apogee[-1]) and triggers[drogue][-1] > apogee[-1]
+    assert height[np.searchsorted(t, apogee[-1])] == pytest.approx(height.max(), abs=0.1)  # the true apogee
 
 
 def test_thesis_sensors_navigation_has_not_diverged(thesis):

@@ -711,12 +711,15 @@ class PositionFilterConfig(_Strict):
 
 
 class FiltersConfig(_Strict):
-    """The navigation filters of ``navigation = "filters"``: initialised from the launch rail's elevation and
-    azimuth ("rail") or from the mean of ``pad_samples`` accelerometer and magnetometer samples on the pad (TRIAD,
-    "pad": the motor must light after them, ``rocket.motor.ignition_delay_s``); their tunings."""
+    """The navigation filters of ``navigation = "filters"``: initialised from the launch rail's nominal elevation and
+    azimuth ("rail") or from the mean of ``pad_samples`` accelerometer and magnetometer samples on the pad (TRIAD)
+    and the gyroscope's mean rate there as its bias ("pad": the motor must light after them,
+    ``rocket.motor.ignition_delay_s``); their tunings."""
 
-    initialisation: Literal["rail", "pad"] = Field("rail", description="the rail's attitude, or TRIAD on the pad")
-    pad_samples: int = Field(500, ge=1, le=100_000, description="GNC ticks on the pad averaged for TRIAD (\"pad\")")
+    initialisation: Literal["rail", "pad"] = Field(
+        "rail", description="the nominal rail's attitude, or TRIAD and the gyro's mean (its bias) on the pad")
+    pad_samples: int = Field(500, ge=1, le=100_000,
+                             description="GNC ticks on the pad averaged for TRIAD and the gyro bias (\"pad\")")
     attitude: AttitudeFilterConfig = AttitudeFilterConfig()
     position: PositionFilterConfig = PositionFilterConfig()
 

@@ -33,6 +33,7 @@ from ..env.magnetic import igrf_site_field_gradient, site_field_gradient, site_f
 from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
+from ..sim.flight import rail_start_n
 from ..sim.params import Environment, FlightParams, Launch, Rocket
 from .config import Campaign, FiltersConfig, sample_period_ticks, sensor_ticks
 from .sampling import realization_key, stream_key
@@ -176,7 +177,16 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
     else:
         table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
     filters = filter_params(campaign) if gnc.navigation == "filters" else None
-    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation, filters)
+    rail = (None, None) if gnc.navigation == "truth" else nominal_rail(campaign)
+    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation, filters, *rail)
+
+
+def nominal_rail(campaign: Campaign) -> tuple[Quat, Vec3]:
+    """What the avionics know of the launch: the campaign's nominal rail (its configured elevation and azimuth, not a
+    realization's draw), its attitude (body → NED) and the nominal rocket's CG at rest on it [m, NED]."""
+    airframe = nominal_params(dataclasses.replace(campaign, config=campaign.config.model_copy(
+        update={"gnc": None, "avionics": None})))  # fmt: skip
+    return airframe.launch.q_nb0, rail_start_n(airframe)
 
 
 def filter_params(campaign: Campaign) -> FilterParams:

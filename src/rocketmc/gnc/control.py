@@ -38,7 +38,9 @@ class GncParams:
     ``speed`` (axial body speed u [m/s]) and, when the design grid has several, ``altitude`` (above mean sea
     level [m]), outputs ``GAIN_NAMES`` (clamped at the grid's edges); anti_windup: conditional integration
     (``gnc_step``; static); navigation: "truth", "sensors" or "filters" (``gnc.navigation``; static); filters: the
-    navigation filters' parameters (None unless "filters")."""
+    navigation filters' parameters (None unless "filters"); rail_q_nb, rail_r_n: what the avionics know of the
+    launch, the campaign's nominal rail: its attitude (body → NED) and the CG's position at rest on it [m, NED],
+    where navigation from the sensors starts (None with "truth")."""
 
     servo: ServoParams
     guidance: GuidanceParams
@@ -46,6 +48,8 @@ class GncParams:
     anti_windup: bool = static_field(default=True)
     navigation: str = static_field(default="truth")
     filters: FilterParams | None = None
+    rail_q_nb: Quat | None = None
+    rail_r_n: Vec3 | None = None
 
 
 @pytree_dataclass
@@ -56,7 +60,8 @@ class GncState:
     active; tracking_sq, ∫χ² dt [rad²·s], and deflection_sq, ∫ mean over the fins of δ² dt [rad²·s], over that
     time; saturated_time [s] active with a fin saturated; max_deflection, the largest |δ| of any fin at a
     period start [rad]. navigation: the navigation's state (``gnc.navigation``: ``DeadReckoning`` with "sensors",
-    ``FilterState`` with "filters", None with "truth")."""
+    ``FilterState`` with "filters", None with "truth"); recovery: the parachutes' triggers from that navigation
+    (``Recovery``; None with "truth")."""
 
     servo: ServoState
     integrators: Vec3
@@ -69,20 +74,55 @@ class GncState:
     saturated_time: jnp.ndarray
     max_deflection: jnp.ndarray
     navigation: DeadReckoning | FilterState | None = None
+    recovery: Recovery | None = None
 
 
-def initial_gnc(params: GncParams, like, q_nb0: Quat | None = None, r_n0: Vec3 | None = None) -> GncState:
-    """At rest on the rail: servos at their zero, integrators empty, no liftoff yet; ``like`` a scalar of the
-    flight's dtype; q_nb0, r_n0: the launch attitude and the CG's position [m, NED], where navigation from the
-    sensors starts (``params.navigation`` "sensors" or "filters")."""
+APOGEE_DESCENDING_TICKS = 5
+"""Apogee is sensed at the fifth consecutive GNC tick (0.1 s at 50 Hz) after the sensed liftoff whose estimated
+vertical velocity points down: the flight software's guard against a noisy estimate crossing zero."""
+
+
+@pytree_dataclass
+class Recovery:
+    """The parachutes' triggers from the navigation (``sensed_triggers``): descending_ticks, the consecutive GNC
+    ticks with the estimated vertical velocity downward (int32); apogee_time, the tick apogee was sensed at [s]
+    (inf before)."""
+
+    descending_ticks: jnp.ndarray
+    apogee_time: jnp.ndarray
+
+
+def sensed_triggers(state: Recovery, nav: Navigation, moving, t, trigger_altitudes_m, trigger_times
+                    ) -> tuple[Recovery, tuple]:  # fmt: skip
+    """The flight software's parachute triggers at the GNC tick t [s] from the navigation solution ``nav``: apogee
+    once the estimated vertical velocity has pointed down for ``APOGEE_DESCENDING_TICKS`` ticks after the sensed
+    liftoff (``moving``); then each parachute not yet triggered (``trigger_times`` [s], inf) triggers at t once the
+    estimated height above the pad is at most its trigger altitude (``trigger_altitudes_m`` [m]; inf: at apogee).
+    Returns the new state and the trigger times."""
+    descending = moving & (nav.v_n.z > 0.0)
+    ticks = jnp.where(descending, state.descending_ticks + 1, 0)
+    sensed = jnp.isinf(state.apogee_time) & (ticks >= APOGEE_DESCENDING_TICKS)
+    apogee_time = jnp.where(sensed, t, state.apogee_time)
+    height = -nav.r_n.z
+    triggers = tuple(jnp.where(jnp.isfinite(apogee_time) & jnp.isinf(trigger) & (height <= altitude), t, trigger)
+                     for altitude, trigger in zip(trigger_altitudes_m, trigger_times))  # fmt: skip
+    return Recovery(ticks, apogee_time), triggers
+
+
+def initial_gnc(params: GncParams, like) -> GncState:
+    """At rest on the rail: servos at their zero, integrators empty, no liftoff yet, navigation from the sensors
+    (``params.navigation`` "sensors" or "filters") at the nominal rail (``params.rail_q_nb``, ``rail_r_n``); ``like``
+    a scalar of the flight's dtype."""
     zero = jnp.zeros_like(like)
     fins = jnp.zeros_like(params.servo.offset_rad)
+    q_nb0, r_n0 = params.rail_q_nb, params.rail_r_n
     navigation = {"truth": lambda: None, "sensors": lambda: initial_dead_reckoning(q_nb0),
                   "filters": lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
+    recovery = None if params.navigation == "truth" else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf)
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),
-        zero, zero, zero, zero, zero, navigation,
+        zero, zero, zero, zero, zero, navigation, recovery,
     )  # fmt: skip
 
 
@@ -111,12 +151,14 @@ def unwinding_only(k, state: GncState, stepped: Vec3) -> Vec3:
     return Vec3(*kept)
 
 
-def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt, altitude_msl, canopy) -> GncState:
+def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt, altitude_msl, canopy,
+             feedback_rad=None) -> GncState:  # fmt: skip
     """The GNC at a period start t [s] (simulation clock): liftoff detection, guidance, integrators, LQI,
     allocation, the command held by the servos, and the totals of the period dt [s] (the GNC period: the
     controller is never active in the longer descent periods). nav: the navigation solution; moving: the
     navigation sees the rocket off the pad (bool; the first such period start is liftoff); altitude_msl: its
-    altitude [m]; canopy: a parachute has been triggered (bool).
+    altitude [m]; canopy: a parachute has been triggered (bool); feedback_rad: the servo positions δ1..δ4 [rad]
+    the LQI reads for its actuator states (the canard-feedback sensor's; None: the servos' true deflections).
 
     Anti-windup (``params.anti_windup``), conditional integration per axis: while the last command saturated
     a fin, an integrator steps only if its step moves its own virtual command (roll for e_p, pitch for e_q,
@@ -131,7 +173,8 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
     errors = integrate_errors(state.integrators, rates_cmd, nav.omega_b, dt, active, params.guidance.integrator_gain)
     if params.anti_windup:
         errors = unwinding_only(k, state, errors)
-    u_yaw, u_pitch, u_roll, _ = mix(*(state.servo.deflection_rad[i] for i in range(4)))
+    feedback = state.servo.deflection_rad if feedback_rad is None else feedback_rad
+    u_yaw, u_pitch, u_roll, _ = mix(*(feedback[i] for i in range(4)))
     omega = nav.omega_b
     x = (v_b.y, v_b.z, omega.x, omega.y, omega.z, u_yaw, u_pitch, u_roll, errors.x, errors.y, errors.z)
     command = Vec3(*(jnp.where(active, u, 0.0) for u in lqi_command(k, x)))  # (yaw, pitch, roll)
@@ -155,6 +198,7 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
         state.saturated_time + jnp.where(saturated, active_dt, 0.0),
         functools.reduce(jnp.maximum, [jnp.abs(d) for d in deflections], state.max_deflection),
         state.navigation,
+        state.recovery,
     )
 
 

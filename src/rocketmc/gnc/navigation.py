@@ -86,10 +86,11 @@ class FilterParams:
     model's field at the pad [T, NED] and field_gradient (3, 3) its derivative along r_n [T/m] (the reference
     field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
     ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
-    the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD (0:
-    from the rail; static); horizontal_only: GNSS updates of north and east only (static); barometer: the
-    barometric height update (static); field_gate, gnss_gate, altitude_gate: the innovation gates of the
-    magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off; static)."""
+    the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD and whose
+    gyroscope samples the bias (0: from the rail, zero bias; static); horizontal_only: GNSS updates of north and
+    east only (static); barometer: the barometric height update (static); field_gate, gnss_gate, altitude_gate: the
+    innovation gates of the magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off;
+    static)."""
 
     attitude: AttitudeTuning
     position: PositionTuning
@@ -109,8 +110,9 @@ class FilterState:
     """The filters' state: t, the time of the last solution [s]; attitude, position: the estimates then (a
     posteriori); omega_measured_b: the gyroscope's last rates [rad/s, body frame], with which the attitude is
     propagated over the next period; on the pad (before liftoff is sensed): the sums of the accelerometer's and
-    magnetometer's samples [m/s², T, body frame] (their directions initialise TRIAD), of the barometer's [Pa] and
-    their count (their mean is the pad pressure the barometric height is measured from), the GNC ticks on the pad;
+    magnetometer's samples [m/s², T, body frame] (their directions initialise TRIAD), of the gyroscope's [rad/s,
+    body frame] and their count (their mean initialises the bias with TRIAD), of the barometer's [Pa] and their
+    count (their mean is the pad pressure the barometric height is measured from), the GNC ticks on the pad;
     failed: a covariance was not finite or not positive (latched); errors: the estimation errors' totals
     (``NavigationErrors``); rejected (3,): the fresh magnetometer, GNSS and barometer samples their innovation gates
     rejected (counts)."""
@@ -121,6 +123,8 @@ class FilterState:
     omega_measured_b: Vec3
     pad_force_b: Vec3
     pad_field_b: Vec3
+    pad_rate_b: Vec3
+    pad_rate_count: jnp.ndarray
     pad_pressure_sum: jnp.ndarray
     pad_pressure_count: jnp.ndarray
     pad_ticks: jnp.ndarray
@@ -153,14 +157,15 @@ class NavigationErrors:
 
 
 def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterState:
-    """At rest on the pad at t = 0: the attitude from the rail (``q_nb0``; replaced by TRIAD after the pad
-    samples when ``params.pad_samples``), the position ``r_n0`` [m, NED] (the CG on the rail), at rest."""
+    """At rest on the pad at t = 0: the attitude from the rail (``q_nb0``, the nominal rail's in a flight: what the
+    avionics know; replaced by TRIAD and the gyroscope's pad mean after the pad samples when ``params.pad_samples``),
+    the position ``r_n0`` [m, NED] (the CG on that rail), at rest."""
     zero = jnp.zeros_like(q_nb0.w)
     still = Vec3(zero, zero, zero)
     nan = zero + jnp.nan
     errors = NavigationErrors(zero, zero, zero, zero, zero, zero, zero, zero, nan, nan, nan, nan, nan)
     return FilterState(zero, initial_attitude(q_nb0, params.attitude), initial_position(r_n0, params.position),
-                       still, still, still, zero, zero, zero, jnp.zeros_like(zero, dtype=bool), errors,
+                       still, still, still, still, zero, zero, zero, zero, jnp.zeros_like(zero, dtype=bool), errors,
                        jnp.zeros((*zero.shape, 3), dtype=jnp.int32))  # fmt: skip
 
 
@@ -227,8 +232,10 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     attitude with the gyroscope's rates then; the magnetometer updates the attitude, the GNSS (after
     ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh (and accepted by its gate,
     ``innovation_gate``; the rejections counted). On the pad (``moving`` False: liftoff not yet sensed) the pad sums
-    grow; after ``pad_samples`` ticks there TRIAD sets the attitude.
-    ``idle`` (a parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
+    grow; after ``pad_samples`` ticks there TRIAD sets the attitude and the gyroscope's mean the bias (the rocket is
+    at rest: the mean rate is the bias, plus the Earth's rotation, ≤ 7.3e-5 rad/s, which this flat, non-rotating
+    Earth does not fly).
+    ``idle`` (in a flight: every parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
     solution (body rates: the gyroscope's less the estimated bias) and the new state (its ``errors`` untouched:
     ``track_errors``)."""
     dt = t - state.t
@@ -244,12 +251,15 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     pad_ticks = state.pad_ticks + on_pad
     pad_force_b = tree_where(on_pad & m.force_fresh, state.pad_force_b + m.force_b, state.pad_force_b)
     pad_field_b = tree_where(on_pad & m.field_fresh, state.pad_field_b + m.field_b, state.pad_field_b)
+    pad_rate_b = tree_where(on_pad & m.omega_valid, state.pad_rate_b + m.omega_b, state.pad_rate_b)
+    pad_rate_count = state.pad_rate_count + (on_pad & m.omega_valid)
     pad_pressure_sum = state.pad_pressure_sum + jnp.where(on_pad & m.pressure_fresh, m.pressure, 0.0)
     pad_pressure_count = state.pad_pressure_count + (on_pad & m.pressure_fresh)
     if params.pad_samples:
         aligned = on_pad & (pad_ticks == params.pad_samples)
-        attitude = tree_where(aligned, initial_attitude(triad(pad_force_b, pad_field_b, reference), params.attitude),
-                              attitude)  # fmt: skip
+        aligned_attitude = initial_attitude(triad(pad_force_b, pad_field_b, reference), params.attitude)
+        bias_b = pad_rate_b * (1.0 / jnp.maximum(pad_rate_count, 1))
+        attitude = tree_where(aligned, dataclasses.replace(aligned_attitude, bias_b=bias_b), attitude)
 
     fix = (t >= params.gnss_after_s) & m.gnss_fresh
     gnss_r, gnss_v = Vec3(*(m.gnss[i] for i in range(3))), Vec3(*(m.gnss[3 + i] for i in range(3)))
@@ -267,8 +277,9 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     rejected = state.rejected + jnp.stack([m.field_fresh & ~field_ok, fix & ~gnss_ok, use & ~height_ok], axis=-1)
 
     omega_measured_b = tree_where(m.omega_valid, m.omega_b, Vec3(0.0, 0.0, 0.0))
-    new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_pressure_sum,
-                      pad_pressure_count, pad_ticks, state.failed, state.errors, rejected)  # fmt: skip
+    new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_rate_b,
+                      pad_rate_count, pad_pressure_sum, pad_pressure_count, pad_ticks, state.failed, state.errors,
+                      rejected)  # fmt: skip
     failing = ~_covariance_ok(new)
     new = tree_where(idle | state.failed | failing, dataclasses.replace(state, t=t), new)  # the last good estimates
     new = dataclasses.replace(new, failed=state.failed | failing)

@@ -24,7 +24,7 @@ from ..env import (
     G0, TurbulenceState, advance_turbulence, gust_n, initial_turbulence, turbulence_noise, turbulence_scales,
 )  # fmt: skip
 from ..env.atmosphere import MAX_ALTITUDE_M
-from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, truth
+from ..gnc.control import GncState, control_summary, gnc_step, initial_gnc, sensed_triggers, truth
 from ..gnc.guidance import guidance_active
 from ..gnc.navigation import (
     DIVERGED_MEANING, bus_measurements, dead_reckoning, filter_step, liftoff_sensed, navigation_summary, track_errors,
@@ -277,13 +277,16 @@ def update_events(
     apogee_east = jnp.where(hit, _lerp(b0.r_n.y, b1.r_n.y, s), ev.apogee_east)
     past_apogee = jnp.isfinite(apogee_time)
 
-    # Parachute triggers: after apogee, at or below the trigger altitude (inf: at apogee).
-    triggers = []
-    for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
-        g0, g1 = alt0 - chute.trigger_altitude_agl_m, alt1 - chute.trigger_altitude_agl_m
-        hit = past_apogee & jnp.isinf(trigger_time) & (g1 <= 0.0)
-        crossing_time = t0 + _crossing_fraction(g0, g1) * h
-        triggers.append(jnp.where(hit, jnp.maximum(crossing_time, apogee_time), trigger_time))
+    # Parachute triggers: after apogee, at or below the trigger altitude (inf: at apogee); the navigation's at the
+    # GNC ticks instead when it is the sensors' (``step``).
+    triggers = ev.chute_trigger_times
+    if not sensed_recovery(p):
+        triggers = []
+        for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
+            g0, g1 = alt0 - chute.trigger_altitude_agl_m, alt1 - chute.trigger_altitude_agl_m
+            hit = past_apogee & jnp.isinf(trigger_time) & (g1 <= 0.0)
+            crossing_time = t0 + _crossing_fraction(g0, g1) * h
+            triggers.append(jnp.where(hit, jnp.maximum(crossing_time, apogee_time), trigger_time))
 
     # Impact: the CG reaches the ground after apogee.
     hit = past_apogee & jnp.isinf(ev.impact_time) & (alt1 <= 0.0)
@@ -302,6 +305,12 @@ def update_events(
     )  # fmt: skip
 
 
+def sensed_recovery(p: FlightParams) -> bool:
+    """Whether the parachutes are triggered by the navigation at the GNC ticks (``gnc.control.sensed_triggers``): a
+    controller navigating from the sensors; else by the true apogee and height (``update_events``). Static."""
+    return p.gnc is not None and p.gnc.navigation != "truth"
+
+
 def initial_state(p: FlightParams) -> FlightState:
     """At rest on the rail, the nozzle exit at the pad, t = 0."""
     zero = jnp.zeros_like(p.rocket.dry_mass_kg)
@@ -314,7 +323,7 @@ def initial_state(p: FlightParams) -> FlightState:
     )  # fmt: skip
     turbulence = p.environment.turbulence
     filters = None if turbulence is None else initial_turbulence(turbulence)
-    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero, p.launch.q_nb0, body.r_n)
+    gnc = None if p.gnc is None else initial_gnc(p.gnc, zero)
     avionics = None if p.avionics is None else initial_avionics(p.avionics, zero)
     return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters, gnc, avionics)
 
@@ -326,13 +335,16 @@ def done(state: FlightState):
 
 def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
     """True under a fully open canopy once every triggered opening has settled, unless a wind-layer
-    boundary is within one descent step (its wind jump is a transient too)."""
+    boundary is within one descent step (its wind jump is a transient too) or, with ``sensed_recovery``, a
+    parachute waits for its trigger (the avionics sample and navigate at the GNC rate until then)."""
     t, events = state.t, state.events
     any_open, transient = False, False
     for chute, trigger_time in zip(p.rocket.parachutes, events.chute_trigger_times):
         settled = trigger_time + chute.delay_s + chute.opening_time_s + settings.settle_s
         any_open = any_open | (t >= settled)
         transient = transient | (jnp.isfinite(trigger_time) & (t < settled))
+        if sensed_recovery(p):
+            transient = transient | jnp.isinf(trigger_time)
     altitude = -state.body.r_n.z
     reach = jnp.abs(state.body.v_n.z) * settings.descent_dt_s + 1.0
     for jump_altitude in p.environment.wind.jump_altitudes_m():
@@ -422,7 +434,8 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     deflections of the period, ``control_step``, then the accelerometer. start_n: ``rail_start_n(p)``;
     noise: the period's ``StepNoise``; canard_command: open-loop deflections, a function of time [s]
     returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when ``p.gnc`` is set:
-    guidance and control at the period start, the servos' response inside it)."""
+    guidance and control at the period start, the servos' response inside it; navigating from the sensors, the
+    LQI reads the canard feedback and the parachutes trigger on the navigation, ``sensed_recovery``)."""
     period = control_period(p, settings, state)
     sensing = period <= settings.control_dt_s  # the sensors sample in GNC periods only, not in long descent ones
     if p.gnc is None:
@@ -437,6 +450,7 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     servo_params, t0 = p.gnc.servo, state.t
     state = start = _sensed(p, state, state.gnc.servo.deflection_rad, sensing, noise)
     canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in state.events.chute_trigger_times], False)
+    feedback = None
     if p.gnc.navigation == "truth":
         nav, moving = truth(state.body)
     else:
@@ -446,11 +460,20 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
         if p.gnc.navigation == "sensors":
             nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
         else:
+            # the filters idle once every parachute is triggered: nothing is left for their solution to decide
+            pending = functools.reduce(jnp.logical_or, [jnp.isinf(t) for t in state.events.chute_trigger_times], False)
             measured = bus_measurements(p.avionics, bus)
-            nav, navigation = filter_step(p.gnc.filters, state.gnc.navigation, measured, t0, moving, canopy)
-        state = dataclasses.replace(state, gnc=dataclasses.replace(state.gnc, navigation=navigation))
+            nav, navigation = filter_step(p.gnc.filters, state.gnc.navigation, measured, t0, moving, canopy & ~pending)
+        recovery, triggers = sensed_triggers(state.gnc.recovery, nav, moving, t0,
+                                             [chute.trigger_altitude_agl_m for chute in p.rocket.parachutes],
+                                             state.events.chute_trigger_times)  # fmt: skip
+        canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in triggers], False)
+        events = dataclasses.replace(state.events, chute_trigger_times=triggers)
+        gnc = dataclasses.replace(state.gnc, navigation=navigation, recovery=recovery)
+        state = dataclasses.replace(state, gnc=gnc, events=tree_where(done(state), state.events, events))
+        feedback = jnp.where(bus.canard_feedback.valid, bus.canard_feedback.value, 0.0)  # the servos' sensed positions
     altitude_msl = p.environment.site_altitude_m - nav.r_n.z
-    gnc = gnc_step(p.gnc, state.gnc, nav, moving, t0, settings.control_dt_s, altitude_msl, canopy)
+    gnc = gnc_step(p.gnc, state.gnc, nav, moving, t0, settings.control_dt_s, altitude_msl, canopy, feedback)
     if p.gnc.navigation == "filters":
         gnc = dataclasses.replace(gnc, navigation=_tracked(p, settings, state, gnc, canopy))
     servo = end_of_period(servo_params, gnc.servo, period)
