@@ -49,7 +49,8 @@ def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: 
     part's."""
     path = CAMPAIGNS / "lynx_ballistic_gnc_1s.toml"
     raw = tomllib.loads(path.read_text())
-    raw["environment"] = {"wind": {"model": "constant", "speed_mps": 10.0, "from_deg": raw["launch"]["azimuth_deg"]}}
+    raw["environment"] = {"wind": {"model": "constant", "speed_mps": 10.0, "from_deg": raw["launch"]["azimuth_deg"]},
+                          "magnetic_field": raw["environment"]["magnetic_field"]}  # the thesis's dipole, as flown
     raw["dispersions"] = {}
     if not errors:
         raw["avionics"].update({sensor: {"truth_only": True} for sensor in
