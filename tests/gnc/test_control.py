@@ -187,16 +187,19 @@ def test_lanes_bitwise_whatever_the_batch(params):
 def test_parachutes_trigger_on_the_navigation_solution():
     """``sensed_triggers``: apogee once the estimated vertical velocity has pointed down for
     APOGEE_DESCENDING_TICKS consecutive ticks after liftoff (a shorter run of downward noise resets the count;
-    no apogee before liftoff), the drogue (trigger altitude inf) at that tick, the main at the first tick after it
-    whose estimated height is at or below its altitude."""
-    altitudes = (jnp.inf, 350.0)
-    state = control.Recovery(jnp.asarray(0, jnp.int32), jnp.asarray(jnp.inf))
+    no apogee before liftoff), the drogue (trigger altitude inf) at that tick; the main (an altitude) is left to the
+    integration (``sim.flight.update_events``); the navigation's height error is kept until a canopy is out, then
+    held."""
+    altitudes = (jnp.asarray(jnp.inf), jnp.asarray(350.0))
+    state = control.Recovery(jnp.asarray(0, jnp.int32), jnp.asarray(jnp.inf), jnp.asarray(0.0))
     triggers = (jnp.asarray(jnp.inf), jnp.asarray(jnp.inf))
 
-    def tick(state, triggers, t, height, down_mps, moving=True):
+    def tick(state, triggers, t, height, down_mps, moving=True, canopy=False, true_height=None):
         still = Vec3(0.0, 0.0, 0.0)
         nav = Navigation(Vec3(0.0, 0.0, -height), Vec3(0.0, 0.0, down_mps), Quat(1.0, 0.0, 0.0, 0.0), still)
-        return control.sensed_triggers(state, nav, jnp.asarray(moving), jnp.asarray(t), altitudes, triggers)
+        truth = height - 7.0 if true_height is None else true_height  # the estimate 7 m high
+        return control.sensed_triggers(state, nav, jnp.asarray(truth), jnp.asarray(moving), jnp.asarray(canopy),
+                                       jnp.asarray(t), altitudes, triggers)  # fmt: skip
 
     n = control.APOGEE_DESCENDING_TICKS
     for k in range(2 * n):  # on the pad, a falling estimate: not an apogee before liftoff
@@ -209,7 +212,7 @@ def test_parachutes_trigger_on_the_navigation_solution():
     assert np.isinf(float(state.apogee_time)) and np.isinf(triggers).all()
     state, triggers = tick(state, triggers, t, 1600.0, 1.0)  # the n-th consecutive tick down
     assert float(state.apogee_time) == t and float(triggers[0]) == t and np.isinf(float(triggers[1]))
-    state, triggers = tick(state, triggers, t + DT, 350.5, 20.0)
-    assert np.isinf(float(triggers[1]))
-    state, triggers = tick(state, triggers, t + 2 * DT, 350.0, 20.0)  # at its altitude: the main
-    assert float(triggers[0]) == t and float(triggers[1]) == t + 2 * DT
+    assert float(state.height_error_m) == 7.0
+    state, triggers = tick(state, triggers, t + DT, 300.0, 20.0, canopy=True, true_height=250.0)  # under the drogue
+    assert np.isinf(float(triggers[1])) and float(triggers[0]) == t
+    assert float(state.height_error_m) == 7.0  # held: the filters idle under canopy

@@ -86,27 +86,30 @@ vertical velocity points down: the flight software's guard against a noisy estim
 class Recovery:
     """The parachutes' triggers from the navigation (``sensed_triggers``): descending_ticks, the consecutive GNC
     ticks with the estimated vertical velocity downward (int32); apogee_time, the tick apogee was sensed at [s]
-    (inf before)."""
+    (inf before); height_error_m, the navigation's height above the pad less the true one at its last tick before a
+    canopy [m] (held after: the filters idle under canopy), which the altitude triggers fly with."""
 
     descending_ticks: jnp.ndarray
     apogee_time: jnp.ndarray
+    height_error_m: jnp.ndarray
 
 
-def sensed_triggers(state: Recovery, nav: Navigation, moving, t, trigger_altitudes_m, trigger_times
-                    ) -> tuple[Recovery, tuple]:  # fmt: skip
+def sensed_triggers(state: Recovery, nav: Navigation, true_height_m, moving, canopy, t, trigger_altitudes_m,
+                    trigger_times) -> tuple[Recovery, tuple]:  # fmt: skip
     """The flight software's parachute triggers at the GNC tick t [s] from the navigation solution ``nav``: apogee
     once the estimated vertical velocity has pointed down for ``APOGEE_DESCENDING_TICKS`` ticks after the sensed
-    liftoff (``moving``); then each parachute not yet triggered (``trigger_times`` [s], inf) triggers at t once the
-    estimated height above the pad is at most its trigger altitude (``trigger_altitudes_m`` [m]; inf: at apogee).
-    Returns the new state and the trigger times."""
+    liftoff (``moving``), when the parachutes triggered at apogee (``trigger_altitudes_m`` inf) trigger, at t; the
+    navigation's height error against ``true_height_m`` [m] kept while no canopy is out (bool ``canopy``). The
+    altitude triggers fire inside the integration (``sim.flight.update_events``) where the true height plus that
+    error crosses their altitude. Returns the new state and the trigger times [s] (``trigger_times``, inf before)."""
     descending = moving & (nav.v_n.z > 0.0)
     ticks = jnp.where(descending, state.descending_ticks + 1, 0)
     sensed = jnp.isinf(state.apogee_time) & (ticks >= APOGEE_DESCENDING_TICKS)
     apogee_time = jnp.where(sensed, t, state.apogee_time)
-    height = -nav.r_n.z
-    triggers = tuple(jnp.where(jnp.isfinite(apogee_time) & jnp.isinf(trigger) & (height <= altitude), t, trigger)
+    triggers = tuple(jnp.where(sensed & jnp.isinf(altitude) & jnp.isinf(trigger), t, trigger)
                      for altitude, trigger in zip(trigger_altitudes_m, trigger_times))  # fmt: skip
-    return Recovery(ticks, apogee_time), triggers
+    height_error = jnp.where(canopy, state.height_error_m, -nav.r_n.z - true_height_m)
+    return Recovery(ticks, apogee_time, height_error), triggers
 
 
 def initial_gnc(params: GncParams, like) -> GncState:
@@ -118,7 +121,7 @@ def initial_gnc(params: GncParams, like) -> GncState:
     q_nb0, r_n0 = params.rail_q_nb, params.rail_r_n
     navigation = {"truth": lambda: None, "sensors": lambda: initial_dead_reckoning(q_nb0),
                   "filters": lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
-    recovery = None if params.navigation == "truth" else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf)
+    recovery = None if params.navigation == "truth" else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf, zero)
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),

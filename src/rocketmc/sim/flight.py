@@ -232,11 +232,14 @@ def rail_start_n(p: FlightParams) -> Vec3:
 
 
 def update_events(
-    p: FlightParams, start_n: Vec3, ev: Events, t0, h, b0: RigidBodyState, b1: RigidBodyState, diag: Diagnostics
+    p: FlightParams, start_n: Vec3, ev: Events, t0, h, b0: RigidBodyState, b1: RigidBodyState, diag: Diagnostics,
+    sensed=None,
 ) -> Events:
     """Detect the events inside the step ``[t0, t0 + h]`` from ``b0`` to ``b1`` and interpolate them.
 
-    start_n: ``rail_start_n(p)``, passed in so that it is computed once per flight.
+    start_n: ``rail_start_n(p)``, passed in so that it is computed once per flight; sensed: with
+    ``sensed_recovery(p)``, (the navigation's held height error [m], whether it has sensed apogee (bool)) from
+    ``gnc.control.Recovery``, else None (the true apogee and height trigger the parachutes).
     """
     rail = p.launch.rail_direction_n
     motor = p.rocket.motor
@@ -277,16 +280,23 @@ def update_events(
     apogee_east = jnp.where(hit, _lerp(b0.r_n.y, b1.r_n.y, s), ev.apogee_east)
     past_apogee = jnp.isfinite(apogee_time)
 
-    # Parachute triggers: after apogee, at or below the trigger altitude (inf: at apogee); the navigation's at the
-    # GNC ticks instead when it is the sensors' (``step``).
-    triggers = ev.chute_trigger_times
-    if not sensed_recovery(p):
-        triggers = []
-        for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
-            g0, g1 = alt0 - chute.trigger_altitude_agl_m, alt1 - chute.trigger_altitude_agl_m
+    # Parachute triggers: after apogee, at or below the trigger altitude (inf: at apogee). Navigating from the
+    # sensors (``sensed``: the navigation's held height error [m] and whether it has sensed apogee), the altitude
+    # triggers fire where the true height plus that error crosses their altitude after the sensed apogee, and those
+    # at apogee at the sensed apogee's GNC tick (``step``).
+    triggers = []
+    for chute, trigger_time in zip(p.rocket.parachutes, ev.chute_trigger_times):
+        altitude = chute.trigger_altitude_agl_m
+        if sensed is None:
+            g0, g1 = alt0 - altitude, alt1 - altitude
             hit = past_apogee & jnp.isinf(trigger_time) & (g1 <= 0.0)
+            crossing_time = jnp.maximum(t0 + _crossing_fraction(g0, g1) * h, apogee_time)
+        else:
+            height_error, apogee_sensed = sensed
+            g0, g1 = alt0 + height_error - altitude, alt1 + height_error - altitude
+            hit = apogee_sensed & jnp.isfinite(altitude) & jnp.isinf(trigger_time) & (g1 <= 0.0)
             crossing_time = t0 + _crossing_fraction(g0, g1) * h
-            triggers.append(jnp.where(hit, jnp.maximum(crossing_time, apogee_time), trigger_time))
+        triggers.append(jnp.where(hit, crossing_time, trigger_time))
 
     # Impact: the CG reaches the ground after apogee.
     hit = past_apogee & jnp.isinf(ev.impact_time) & (alt1 <= 0.0)
@@ -335,16 +345,13 @@ def done(state: FlightState):
 
 def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
     """True under a fully open canopy once every triggered opening has settled, unless a wind-layer
-    boundary is within one descent step (its wind jump is a transient too) or, with ``sensed_recovery``, a
-    parachute waits for its trigger (the avionics sample and navigate at the GNC rate until then)."""
+    boundary is within one descent step (its wind jump is a transient too)."""
     t, events = state.t, state.events
     any_open, transient = False, False
     for chute, trigger_time in zip(p.rocket.parachutes, events.chute_trigger_times):
         settled = trigger_time + chute.delay_s + chute.opening_time_s + settings.settle_s
         any_open = any_open | (t >= settled)
         transient = transient | (jnp.isfinite(trigger_time) & (t < settled))
-        if sensed_recovery(p):
-            transient = transient | jnp.isinf(trigger_time)
     altitude = -state.body.r_n.z
     reach = jnp.abs(state.body.v_n.z) * settings.descent_dt_s + 1.0
     for jump_altitude in p.environment.wind.jump_altitudes_m():
@@ -389,6 +396,8 @@ def control_step(
     h = period / settings.substeps
     turbulence = p.environment.turbulence
     mean_wind_n, scales, gust = period_gust(p, state)
+    recovery = state.gnc.recovery if sensed_recovery(p) else None
+    sensed = None if recovery is None else (recovery.height_error_m, jnp.isfinite(recovery.apogee_time))
 
     def rhs(t, y, events):
         d_body, diag = derivatives(t, y, p, deflections(t), gust, events)
@@ -403,7 +412,7 @@ def control_step(
         t0, body0, events, _ = carry
         body1, (diag, derivative) = rk4_step(lambda t, y: rhs(t, y, events), t0, body0, h)
         body1 = normalize_attitude(body1)
-        events = update_events(p, start_n, events, t0, h, body0, body1, diag)
+        events = update_events(p, start_n, events, t0, h, body0, body1, diag, sensed)
         return (t0 + h, body1, events, diag.canopy_stiffness), derivative
 
     carry = (state.t, state.body, state.events, state.canopy_stiffness)
@@ -460,11 +469,9 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
         if p.gnc.navigation == "sensors":
             nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
         else:
-            # the filters idle once every parachute is triggered: nothing is left for their solution to decide
-            pending = functools.reduce(jnp.logical_or, [jnp.isinf(t) for t in state.events.chute_trigger_times], False)
             measured = bus_measurements(p.avionics, bus)
-            nav, navigation = filter_step(p.gnc.filters, state.gnc.navigation, measured, t0, moving, canopy & ~pending)
-        recovery, triggers = sensed_triggers(state.gnc.recovery, nav, moving, t0,
+            nav, navigation = filter_step(p.gnc.filters, state.gnc.navigation, measured, t0, moving, canopy)
+        recovery, triggers = sensed_triggers(state.gnc.recovery, nav, -state.body.r_n.z, moving, canopy, t0,
                                              [chute.trigger_altitude_agl_m for chute in p.rocket.parachutes],
                                              state.events.chute_trigger_times)  # fmt: skip
         canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in triggers], False)
