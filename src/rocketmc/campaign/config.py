@@ -1006,7 +1006,8 @@ class Campaign:
         (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
         campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
         perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
-        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above."""
+        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above, and
+        dispersions by their parameter's path after ``dispersions.``: a table sets one, None removes it."""
         if navigation is not None:
             sensors = navigation != "truth"
         data = self.config.model_dump()
@@ -1022,6 +1023,13 @@ class Campaign:
             kept = current if current != "truth" else "sensors"
             data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
         for path, value in (values or {}).items():
+            if path.startswith("dispersions."):  # a key of the dispersions' table is itself a dotted path
+                key = path.removeprefix("dispersions.")
+                if value is None and key not in data["dispersions"]:
+                    raise ConfigError(f"{path}: not a dispersion of this campaign")
+                data["dispersions"] = {k: d for k, d in data["dispersions"].items() if k != key}
+                data["dispersions"].update({} if value is None else {key: value})
+                continue
             try:
                 data = _set_path(data, path, value)
             except (KeyError, IndexError, TypeError, ValueError):
