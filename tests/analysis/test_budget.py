@@ -2,7 +2,8 @@
 
 Cost: each row flown is one compilation (a sensor's ``truth_only`` is static): the module flies five rows (all,
 none, gyroscope alone, truth, off) and two check rows (the barometer alone; 'none' with the field's error off under
-an IGRF sky), seven compilations, ~1 min each on a free core; the CLI test reuses the five (the process keeps them: ``runner.COMPILED_KEPT`` raised here)."""
+an IGRF sky), seven compilations, ~1 min each on a free core; the CLI test reuses the five (the process keeps them:
+``runner.COMPILED_KEPT`` raised here)."""
 
 import json
 import tomllib
@@ -161,6 +162,12 @@ def test_values_override(campaign):
     assert set(changed.config.dispersions) == set(campaign.config.dispersions) - {wind} | {f"{ANOMALY}.1"}
     with pytest.raises(ConfigError, match=rf"^dispersions\.{ANOMALY}\.1: not a dispersion of this campaign$"):
         campaign.with_overrides(values={f"dispersions.{ANOMALY}.1": None})
+    # a sensor's spread set by value redraws its dispersions: none left once it is zero, the file's own kept
+    spread = campaign.with_overrides(values={"avionics.gyroscope.bias_std": [0.1, 0.0, 0.2]})
+    assert [k for k in spread.config.dispersions if k.startswith("avionics.gyroscope.bias.")] == [
+        "avionics.gyroscope.bias.0", "avionics.gyroscope.bias.2"]  # fmt: skip
+    unspread = spread.with_overrides(values={"avionics.gyroscope.bias_std": [0.0, 0.0, 0.0]})
+    assert unspread.config.dispersions == campaign.config.dispersions
 
 
 ANOMALY = "environment.magnetic_field.anomaly_nt"

@@ -2,11 +2,12 @@
 
 A closed-loop campaign on its navigation filters or raw sensors is flown again with each error source
 alone (every other source off), with all of them (the campaign as written), with none (every source off:
-the filters on perfect sensors, carrying the truth's field), and as two references: perfect navigation (``navigation = "truth"``) and the
-controller off. Every row has the campaign's seed and N, so realization i meets the same winds and draws
-everything else the same in every row (each dispersion, and each sensor's noise, has its own random stream:
-``campaign/sampling.py``). Per row: the 95 % landing ellipse's area, its paired ratios to the other rows, the
-navigation and control metrics of ``sim/flight.py`` (medians and 95th percentiles) and the failed flights.
+the filters on perfect sensors, carrying the truth's field), and as two references: perfect navigation
+(``navigation = "truth"``) and the controller off. Every row has the campaign's seed and N, so realization i meets
+the same winds and draws everything else the same in every row (each dispersion, and each sensor's noise, has its
+own random stream: ``campaign/sampling.py``). Per row: the 95 % landing ellipse's area, its paired ratios to the
+other rows, the navigation and control metrics of ``sim/flight.py`` (medians and 95th percentiles) and the failed
+flights.
 
 A source is an entry of ``SOURCES``: a name, a description, the config overrides that switch it off (dotted path
 -> value, applied by ``Campaign.with_overrides(values=...)``) and why switching it off would change nothing in a
@@ -54,7 +55,8 @@ class Source:
 
 SENSOR_ERRORS = ("bias", "bias_std", "bias_walk", "noise_density", "noise_std", "vibration_per_kpa", "scale_factor",
                  "scale_factor_std", "cross_axis", "cross_axis_std", "misalignment_deg", "misalignment_std_deg",
-                 "hard_iron", "hard_iron_std", "soft_iron_std", "lsb", "position_noise_m", "velocity_noise_mps", "sinusoid_amplitude_m")  # fmt: skip
+                 "hard_iron", "hard_iron_std", "soft_iron_std", "lsb", "position_noise_m", "velocity_noise_mps",
+                 "sinusoid_amplitude_m")  # fmt: skip
 """A sensor's error fields (docs/sensors.md): all zero (or absent), with an identity soft-iron matrix and no
 dispersion of the sensor's values, and it has no error. Its range is not counted: it only clips."""
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
@@ -96,6 +98,7 @@ def _sensor(sensor: str, description: str) -> Source:
 
 
 ANOMALY = "environment.magnetic_field.anomaly_nt"
+"""The truth's field anomaly [nT, NED] (its elements ``.0``-``.2``), which the filters never know."""
 
 
 def _field_model_off(config: CampaignConfig) -> dict[str, object]:

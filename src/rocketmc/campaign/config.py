@@ -1011,6 +1011,9 @@ class Campaign:
         if navigation is not None:
             sensors = navigation != "truth"
         data = self.config.model_dump()
+        spreads = sensor_spreads(self.config)  # drawn by the sensors' spreads, not the file: redrawn from the new ones
+        data["dispersions"] = {k: d for k, d in data["dispersions"].items()
+                               if k not in spreads or self.config.dispersions[k] != spreads[k]}  # fmt: skip
         data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
         if aero_model is not None:
             data["rocket"]["aero"]["model"] = aero_model
