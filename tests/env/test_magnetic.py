@@ -1,5 +1,7 @@
 """IGRF-13 dipole against a closed-form dipole, the full IGRF-13 at the launch sites, secular
-variation, validity range, jit/vmap, the geomagnetic pole and the (a/r)³ fall-off.
+variation, validity range, jit/vmap, the geomagnetic pole and the (a/r)³ fall-off; the IGRF-14 at a site (ppigrf's
+evaluation, its gradient by central differences) on a dipole-only table against the exact dipole and its gradient,
+on the IGRF-13 table against igrf-model, and to first order over the flight's region against ppigrf's geodetic field.
 
 References
 - The dipole written a second way, in ECEF (x to 0° E on the equator, z north): the degree-1
