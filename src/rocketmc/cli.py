@@ -747,7 +747,7 @@ def build_parser() -> argparse.ArgumentParser:
     budget = commands.add_parser(
         "budget", help="the GNC error budget: a closed-loop campaign flown with each navigation error source alone",
         description="Fly a closed-loop campaign (navigation 'filters' or 'sensors') with each navigation error source "
-        "alone, with all (the campaign), with none (the navigation on perfect sensors), on perfect navigation and "
+        "alone, with all (the campaign), with none (the navigation on perfect sensors and the truth's field), on perfect navigation and "
         "with the controller off, every row with the same seed and N (the same winds and draws): the 95 %% landing "
         "ellipse of each row, its paired ratios to the others, the navigation and control errors and the failed "
         "flights. One compilation per row flown; no result file.",
@@ -759,7 +759,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
     budget.add_argument("--sources", metavar="NAME,...",
                         help="the error sources flown alone, separated by commas (default: all of them: "
-                             "accelerometer, gyroscope, magnetometer, barometer, gnss, canard_feedback)")  # fmt: skip
+                             "accelerometer, gyroscope, magnetometer, barometer, gnss, canard_feedback, field_model)")  # fmt: skip
     budget.add_argument("--json", action="store_true", help="print the budget as JSON")
     budget.add_argument("--plot", help="write a bar chart of each row's ellipse area to this PNG")
     budget.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")

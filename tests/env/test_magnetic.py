@@ -1,5 +1,7 @@
 """IGRF-13 dipole against a closed-form dipole, the full IGRF-13 at the launch sites, secular
-variation, validity range, jit/vmap, the geomagnetic pole and the (a/r)³ fall-off.
+variation, validity range, jit/vmap, the geomagnetic pole and the (a/r)³ fall-off; the IGRF-14 at a site (ppigrf's
+evaluation, its gradient by central differences) on a dipole-only table against the exact dipole and its gradient,
+on the IGRF-13 table against igrf-model, and to first order over the flight's region against ppigrf's geodetic field.
 
 References
 - The dipole written a second way, in ECEF (x to 0° E on the equator, z north): the degree-1
@@ -31,8 +33,8 @@ import ppigrf
 from ppigrf.ppigrf import shc_fn_igrf13
 
 from rocketmc.env.magnetic import (
-    IGRF14_TABLE, DipoleCoefficients, _igrf_potential, _ned_axes, dipole_field_ned, first_order_field, geodetic_to_ecef_m,
-    igrf_coefficients, igrf_dipole, igrf_site_field_gradient, igrf_validity, site_field_gradient, site_field_ned,
+    GRADIENT_STEP_M, IGRF14_TABLE, DipoleCoefficients, _ned_axes, dipole_field_ned, first_order_field, igrf_dipole,
+    igrf_site_field_gradient, igrf_validity, site_field_gradient, site_field_ned,
 )
 from rocketmc.math import Vec3
 
@@ -247,24 +249,13 @@ def test_igrf14_against_the_published_igrf13(site):
     assert np.linalg.norm(1e9 * field - np.array(IGRF13_FULL_NT[site])) < 50.0
 
 
-def igrf_points():
-    rng = np.random.default_rng(11)
-    points = [(*SITES["roccaraso"], LAUNCH_DAY), (*SITES["santa_margarida"], LAUNCH_DAY), (*THESIS_SITE, LAUNCH_DAY),
-              (*THESIS_SITE, datetime.date(2030, 1, 1)), (*THESIS_SITE, datetime.date(1900, 1, 1))]  # fmt: skip
-    for _ in range(4):
-        day = datetime.date(1900, 1, 1) + datetime.timedelta(days=int(rng.integers(0, 47482)))
-        points.append((math.degrees(math.asin(rng.uniform(-0.98, 0.98))), rng.uniform(-180.0, 180.0),
-                       rng.uniform(-400.0, 30e3), day))  # fmt: skip
-    return points
-
-
-@pytest.mark.parametrize("point", igrf_points())
-def test_igrf14_against_ppigrf(point):
-    # The same coefficients evaluated twice: Legendre functions by another recursion, and ppigrf's geodetic
-    # components from Olsen's series for the geodetic latitude, which turns the field by ~5e-9 rad (2.5e-4 nT,
-    # measured); 1e-3 nT is 2e-8 of the field, far below any error of a formula or a frame (≥ 1 nT).
-    field, _ = igrf_site_field_gradient(*point)
-    np.testing.assert_allclose(1e9 * field, ppigrf_ned(*point), rtol=0, atol=1e-3)
+def geodetic_to_ecef(latitude_deg, longitude_deg, height_m) -> np.ndarray:
+    """The Earth-centred point [m] of a geodetic latitude, longitude [deg] and height above the WGS84 ellipsoid [m]."""
+    a, e2 = 6378137.0, 0.00669437999014
+    lat, lon = math.radians(latitude_deg), math.radians(longitude_deg)
+    n = a / math.sqrt(1 - e2 * math.sin(lat) ** 2)
+    return np.array([(n + height_m) * math.cos(lat) * math.cos(lon), (n + height_m) * math.cos(lat) * math.sin(lon),
+                     (n * (1 - e2) + height_m) * math.sin(lat)])  # fmt: skip
 
 
 def ecef_to_geodetic(point_m):
@@ -279,46 +270,81 @@ def ecef_to_geodetic(point_m):
     return math.degrees(lat), math.degrees(math.atan2(y, x)), height
 
 
+DIPOLE_TABLE_NT = {"g10": (-29404.8, -29350.0), "g11": (-1450.9, -1410.3), "h11": (4652.5, 4545.5)}
+"""A table of the dipole alone, at 2020.0 and 2025.0 (the IGRF-13 2020 model and the IGRF-14 2025 one's degree 1)."""
+
+
+@pytest.fixture(scope="module")
+def dipole_table(tmp_path_factory) -> str:
+    """DIPOLE_TABLE_NT as an .shc file ppigrf reads (header: degrees 1-1, 2 models, spline order 2, 1 step)."""
+    g10, g11, h11 = DIPOLE_TABLE_NT.values()
+    path = tmp_path_factory.mktemp("shc") / "dipole.shc"
+    path.write_text(f"# degree 1 only\n1 1 2 2 1\n2020.0 2025.0\n1 0 {g10[0]} {g10[1]}\n1 1 {g11[0]} {g11[1]}\n"
+                    f"1 -1 {h11[0]} {h11[1]}\n")  # fmt: skip
+    return str(path)
+
+
+DIPOLE_POINTS = [(*SITES["roccaraso"], LAUNCH_DAY), (*SITES["santa_margarida"], datetime.date(2020, 1, 1)),
+                 (*THESIS_SITE, datetime.date(2025, 1, 1)), (-77.85, 166.67, 30e3, datetime.date(2023, 6, 30))]  # fmt: skip
+"""Points and dates of the dipole table's check: the pads and one 30 km over Antarctica, on both models' dates and
+between them."""
+
+
+@pytest.mark.parametrize("point", DIPOLE_POINTS)
+def test_igrf_path_on_a_dipole_table_against_the_exact_dipole(dipole_table, point):
+    # The whole path (the date to ppigrf, the site onto Earth-centred axes, ppigrf's spherical components turned into
+    # the site's geodetic NED axes, the central differences) on a table of the dipole alone, against the dipole's
+    # closed form B = (a/r)³[3(g·r̂)r̂ − g] and its exact gradient, written here in Earth-centred axes with the
+    # coefficients linear in time between 2020-01-01 and 2025-01-01 (0 h UTC). The field: float64 rounding of a few
+    # operations on both sides (measured ≤ 8e-16 of |B|), 1e-12. The gradient: the differences' truncation (~8e-14 h²)
+    # and ppigrf's rounding (~2.5e-9 m / h) at GRADIENT_STEP_M, measured 3e-11-1e-10 of its largest element (h = 1 m:
+    # 3e-10-2.4e-9, rounding; 1 km: 8.2e-8, truncation); 1e-8 leaves room for both and fails at any error of a frame
+    # or a sign (≥ 1e-3).
+    *site, day = point
+    field, gradient = igrf_site_field_gradient(*site, day, dipole_table)
+    fraction = (day - datetime.date(2020, 1, 1)).days / (datetime.date(2025, 1, 1) - datetime.date(2020, 1, 1)).days
+    g10, g11, h11 = (v0 + fraction * (v1 - v0) for v0, v1 in DIPOLE_TABLE_NT.values())
+    g, a = 1e-9 * np.array([g11, h11, g10]), 6371.2e3
+    r = geodetic_to_ecef(*site)
+    radius = np.linalg.norm(r)
+    exact_field = a**3 * (3.0 * (g @ r) * r / radius**5 - g / radius**3)
+    exact_gradient = a**3 * (3.0 * (np.outer(r, g) + (g @ r) * np.eye(3) + np.outer(g, r)) / radius**5
+                             - 15.0 * (g @ r) * np.outer(r, r) / radius**7)  # fmt: skip
+    axes = np.asarray(_ned_axes(math.radians(site[0]), math.radians(site[1])))
+    np.testing.assert_allclose(field, axes @ exact_field, rtol=0, atol=1e-12 * np.linalg.norm(exact_field))
+    reference = axes @ exact_gradient @ axes.T
+    np.testing.assert_allclose(gradient, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+
+
 @pytest.mark.parametrize("site", [*SITES.values(), THESIS_SITE])
-def test_igrf_gradient_against_ppigrf_finite_differences(site):
-    # Central differences of ppigrf's field over ±200 m along each of the site's axes, each offset point's field turned
-    # from its own north, east, down into the site's (the flat Earth's axes). The field changes on the Earth's scale
-    # (its degree-13 part over ~500 km): truncation ~(200 m / 500 km)² ~ 2e-7 of the gradient; roundoff ~1e-11·|B| over
-    # 400 m ~ 1e-9 nT/m against a gradient of ~0.02 nT/m. 1e-5 of the gradient's largest element covers both.
-    field, gradient = igrf_site_field_gradient(*site, LAUNCH_DAY)
-    lat, lon, height = (math.radians(site[0]), math.radians(site[1]), site[2])
-    axes = np.asarray(_ned_axes(lat, lon))
-    centre = np.asarray(geodetic_to_ecef_m(lat, lon, height))
-
-    def at(offset_n):
-        p_lat, p_lon, p_height = ecef_to_geodetic(centre + axes.T @ offset_n)
-        local = np.asarray(_ned_axes(math.radians(p_lat), math.radians(p_lon)))
-        return 1e-9 * axes @ (local.T @ ppigrf_ned(p_lat, p_lon, p_height, LAUNCH_DAY))
-
-    step = 200.0
-    reference = np.stack([(at(step * e) - at(-step * e)) / (2 * step) for e in np.eye(3)], axis=1)
-    np.testing.assert_allclose(gradient, reference, rtol=0, atol=1e-5 * np.abs(reference).max())
-    # a potential field in free space: symmetric (curl-free) and traceless (divergence-free)
-    np.testing.assert_allclose(gradient, gradient.T, rtol=0, atol=1e-12 * np.abs(gradient).max())
-    assert abs(np.trace(gradient)) < 1e-12 * np.abs(gradient).max()
+def test_igrf_gradient_symmetric_and_traceless(site):
+    # The IGRF-14 is a potential field in free space: its gradient is symmetric (curl-free) and traceless (divergence-
+    # free). Central differences keep both to their truncation and rounding (measured ≤ 1.3e-10 of the largest element);
+    # a point's field left in its own axes (not turned into the site's) breaks the symmetry by ~1/r·|B| ~ 1e-3 of it.
+    _, gradient = igrf_site_field_gradient(*site, LAUNCH_DAY)
+    np.testing.assert_allclose(gradient, gradient.T, rtol=0, atol=1e-8 * np.abs(gradient).max())
+    assert abs(np.trace(gradient)) < 1e-8 * np.abs(gradient).max()
 
 
 @pytest.mark.parametrize("site", [*SITES.values(), THESIS_SITE])
 def test_igrf_to_first_order_over_the_flights_region(site):
-    # Over ±10 km north and east and 0-10 km up the exact field (at the offset point, in the site's axes) is within
-    # 1.4 nT of the first-order one (measured 1.25-1.37 nT at the three sites; 7.9 nT at 30 km up), where the first-
-    # order term itself reaches ~260 nT: 2 nT bounds the second-order term (~|B|·(12/2)(10 km/6371 km)² ≈ 0.7 nT, times
-    # the non-dipole field's shorter scales).
+    # Over ±10 km north and east and 0-10 km up ppigrf's field at the offset point (its geodetic path: the point's
+    # latitude and height, its north, east, down turned into the site's axes) is within 1.4 nT of the first-order one
+    # (measured 1.25-1.37 nT at the three sites; 7.9 nT at 30 km up), where the first-order term itself reaches ~260 nT:
+    # 2 nT bounds the second-order term (~|B|·(12/2)(10 km/6371 km)² ≈ 0.7 nT, times the non-dipole field's shorter
+    # scales). A gradient 1 % off adds ~2.6 nT.
     field, gradient = igrf_site_field_gradient(*site, LAUNCH_DAY)
-    lat, lon = math.radians(site[0]), math.radians(site[1])
-    coefficients = igrf_coefficients(LAUNCH_DAY)
-    axes = np.asarray(_ned_axes(lat, lon))
-    centre = np.asarray(geodetic_to_ecef_m(lat, lon, site[2]))
+    axes = np.asarray(_ned_axes(math.radians(site[0]), math.radians(site[1])))
+    centre = geodetic_to_ecef(*site)
     offsets = np.array([(n, e, -u) for n in (-1e4, 0.0, 1e4) for e in (-1e4, 0.0, 1e4) for u in (0.0, 5e3, 1e4)])
-    grad = jax.jit(jax.vmap(jax.grad(_igrf_potential, argnums=1), in_axes=(None, 0)))
-    exact = -1e-9 * grad(coefficients, centre + offsets @ axes) @ axes.T
-    linear = first_order_field(field, gradient, Vec3(*offsets.T))
-    worst = np.max(np.linalg.norm(exact - np.stack(linear, axis=1), axis=1))
+
+    def exact(offset_n):
+        p_lat, p_lon, p_height = ecef_to_geodetic(centre + axes.T @ offset_n)
+        local = np.asarray(_ned_axes(math.radians(p_lat), math.radians(p_lon)))
+        return 1e-9 * axes @ (local.T @ ppigrf_ned(p_lat, p_lon, p_height, LAUNCH_DAY))
+
+    linear = np.stack(first_order_field(field, gradient, Vec3(*offsets.T)), axis=1)
+    worst = max(np.linalg.norm(exact(offset) - row) for offset, row in zip(offsets, linear))
     assert worst < 2e-9
 
 
@@ -326,12 +352,9 @@ def test_igrf_dates():
     assert igrf_validity() == (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1))
     for day in (datetime.date(1899, 12, 31), datetime.date(2030, 1, 2)):
         with pytest.raises(ValueError, match=rf"{day.isoformat()}.*1900-01-01 to 2030-01-01"):
-            igrf_coefficients(day)
-    # on a model's date the table's own coefficients (g10 of 2025.0: −29350.0 nT), between two the straight line
-    assert float(igrf_coefficients(datetime.date(2025, 1, 1)).g_nt[0]) == -29350.0
-    halfway = datetime.date(2022, 7, 2)  # 912.5 of the 1827 days from 2020-01-01 to 2025-01-01 (less 0.5 day)
-    expected = -29403.41 + (-29350.0 + 29403.41) * (halfway - datetime.date(2020, 1, 1)).days / 1827
-    np.testing.assert_allclose(float(igrf_coefficients(halfway).g_nt[0]), expected, rtol=1e-14)
+            igrf_site_field_gradient(*THESIS_SITE, day)
+    for day in (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1)):  # the table's ends are in
+        assert np.isfinite(igrf_site_field_gradient(*THESIS_SITE, day)[1]).all()
 
 
 def test_igrf_differs_from_the_dipole_at_roccaraso():

@@ -2,16 +2,19 @@
 
 A closed-loop campaign on its navigation filters or raw sensors is flown again with each error source
 alone (every other source off), with all of them (the campaign as written), with none (every source off:
-the filters on perfect sensors), and as two references: perfect navigation (``navigation = "truth"``) and the
-controller off. Every row has the campaign's seed and N, so realization i meets the same winds and draws
-everything else the same in every row (each dispersion, and each sensor's noise, has its own random stream:
-``campaign/sampling.py``). Per row: the 95 % landing ellipse's area, its paired ratios to the other rows, the
-navigation and control metrics of ``sim/flight.py`` (medians and 95th percentiles) and the failed flights.
+the filters on perfect sensors, carrying the truth's field), and as two references: perfect navigation
+(``navigation = "truth"``) and the controller off. Every row has the campaign's seed and N, so realization i meets
+the same winds and draws everything else the same in every row (each dispersion, and each sensor's noise, has its
+own random stream: ``campaign/sampling.py``). Per row: the 95 % landing ellipse's area, its paired ratios to the
+other rows, the navigation and control metrics of ``sim/flight.py`` (medians and 95th percentiles) and the failed
+flights.
 
 A source is an entry of ``SOURCES``: a name, a description, the config overrides that switch it off (dotted path
 -> value, applied by ``Campaign.with_overrides(values=...)``) and why switching it off would change nothing in a
-campaign (its sensor is not read, or it has no error already); such a source is reported, not flown. Each row is
-flown with ``campaign.run_chunks`` (one compilation per row: a sensor's ``truth_only`` is a static switch).
+campaign (its sensor is not read, or it has no error already); such a source is reported, not flown. A sensor's
+errors are switched off by its ``truth_only``; the reference field's (``field_model``) by giving the filters the
+truth's model and zeroing the truth's anomaly, its dispersions removed. Each row is flown with
+``campaign.run_chunks`` (one compilation per row: a sensor's ``truth_only`` is a static switch).
 """
 
 from __future__ import annotations
@@ -52,7 +55,8 @@ class Source:
 
 SENSOR_ERRORS = ("bias", "bias_std", "bias_walk", "noise_density", "noise_std", "vibration_per_kpa", "scale_factor",
                  "scale_factor_std", "cross_axis", "cross_axis_std", "misalignment_deg", "misalignment_std_deg",
-                 "hard_iron", "hard_iron_std", "lsb", "position_noise_m", "velocity_noise_mps", "sinusoid_amplitude_m")  # fmt: skip
+                 "hard_iron", "hard_iron_std", "soft_iron_std", "lsb", "position_noise_m", "velocity_noise_mps",
+                 "sinusoid_amplitude_m")  # fmt: skip
 """A sensor's error fields (docs/sensors.md): all zero (or absent), with an identity soft-iron matrix and no
 dispersion of the sensor's values, and it has no error. Its range is not counted: it only clips."""
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
@@ -93,6 +97,28 @@ def _sensor(sensor: str, description: str) -> Source:
     return Source(sensor, description, lambda config: {f"avionics.{sensor}.truth_only": True}, _sensor_idle(sensor))
 
 
+ANOMALY = "environment.magnetic_field.anomaly_nt"
+"""The truth's field anomaly [nT, NED] (its elements ``.0``-``.2``), which the filters never know."""
+
+
+def _field_model_off(config: CampaignConfig) -> dict[str, object]:
+    """The overrides that give the filters the truth's field: the MEKF carries the environment's model, and the
+    truth's anomaly is zero and not dispersed (only what differs from that)."""
+    truth, carried = config.environment.magnetic_field, config.gnc.filters.attitude.field_model
+    off: dict[str, object] = {} if carried in (None, truth.model) else {"gnc.filters.attitude.field_model": truth.model}
+    off.update({f"{ANOMALY}.{i}": 0.0 for i, value in enumerate(truth.anomaly_nt) if value != 0.0})
+    off.update({f"dispersions.{ANOMALY}.{i}": None for i in range(3) if f"{ANOMALY}.{i}" in config.dispersions})
+    return off
+
+
+def _field_model_idle(config: CampaignConfig) -> str | None:
+    if not sensor_read(config, "magnetometer"):
+        return f"not read by navigation = {config.gnc.navigation!r}"
+    if not _field_model_off(config):
+        return "already perfect (the filters carry the truth's model; no anomaly)"
+    return None
+
+
 SOURCES: dict[str, Source] = {s.name: s for s in (
     _sensor("accelerometer", "the accelerometer's errors (bias, scale, cross-axis, misalignment, noise, walk, vibration)"),
     _sensor("gyroscope", "the gyroscope's errors (bias, scale, cross-axis, misalignment, noise, walk, vibration)"),
@@ -100,8 +126,11 @@ SOURCES: dict[str, Source] = {s.name: s for s in (
     _sensor("barometer", "the barometer's errors (bias, noise, quantisation)"),
     _sensor("gnss", "the GNSS receiver's errors (white noise per fix, slow sinusoidal bias)"),
     _sensor("canard_feedback", "the canard position sensors' errors"),
+    Source("field_model", "the reference field's error (the filters' field model against the truth's, its anomaly)",
+           _field_model_off, _field_model_idle),
 )}  # fmt: skip
-"""The error sources, by name: a later one (a model error, a fault) is one entry more."""
+"""The error sources, by name: each sensor's errors, then the filters' reference field; a later one (a fault) is one
+entry more."""
 
 
 @dataclass
@@ -146,7 +175,7 @@ def budget_rows(campaign: Campaign, sources: Sequence[str] | None = None, refere
     off = {name: source.off(config) for name, source in SOURCES.items()}
     rows = [Row("all", "campaign", "every source as the campaign has it", campaign)]
     busy = any(reason is None for reason in idle.values())
-    rows.append(Row("none", "none", "every source off: navigation on perfect sensors",
+    rows.append(Row("none", "none", "every source off: navigation on perfect sensors and the truth's field",
                     campaign.with_overrides(values=_merged(off.values())) if busy else None,
                     None if busy else "every source changes nothing: the same flights as 'all'"))  # fmt: skip
     for name in names:

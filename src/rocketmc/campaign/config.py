@@ -1016,10 +1016,14 @@ class Campaign:
         (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
         campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
         perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
-        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above."""
+        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above, and
+        dispersions by their parameter's path after ``dispersions.``: a table sets one, None removes it."""
         if navigation is not None:
             sensors = navigation != "truth"
         data = self.config.model_dump()
+        spreads = sensor_spreads(self.config)  # drawn by the sensors' spreads, not the file: redrawn from the new ones
+        data["dispersions"] = {k: d for k, d in data["dispersions"].items()
+                               if k not in spreads or self.config.dispersions[k] != spreads[k]}  # fmt: skip
         data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
         if aero_model is not None:
             data["rocket"]["aero"]["model"] = aero_model
@@ -1032,6 +1036,13 @@ class Campaign:
             kept = current if current != "truth" else "sensors"
             data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
         for path, value in (values or {}).items():
+            if path.startswith("dispersions."):  # a key of the dispersions' table is itself a dotted path
+                key = path.removeprefix("dispersions.")
+                if value is None and key not in data["dispersions"]:
+                    raise ConfigError(f"{path}: not a dispersion of this campaign")
+                data["dispersions"] = {k: d for k, d in data["dispersions"].items() if k != key}
+                data["dispersions"].update({} if value is None else {key: value})
+                continue
             try:
                 data = _set_path(data, path, value)
             except (KeyError, IndexError, TypeError, ValueError):

@@ -1,26 +1,26 @@
 """Geomagnetic field for the magnetometer model: the full IGRF-14 (degrees 1–13) on the WGS84 ellipsoid, and the
 IGRF-13 dipole (degree 1) on a spherical Earth.
 
-The IGRF-14 coefficients are ppigrf's table (``ppigrf.shc_fn_igrf14``; data/igrf/SOURCE.md); the dipole's live in
-``data/igrf/igrf13_dipole.toml``. Leaving out the non-dipole field (degrees 2–13) costs about 7 000–8 000 nT
-(15–18 % of the field, 10–16° of declination) at the Roccaraso and Santa Margarida pads: tests/env/test_magnetic.py.
+The IGRF-14 is ppigrf's: its table (``ppigrf.shc_fn_igrf14``; data/igrf/SOURCE.md) and its evaluation; the dipole's
+coefficients live in ``data/igrf/igrf13_dipole.toml``. Leaving out the non-dipole field (degrees 2–13) costs about
+7 000–8 000 nT (15–18 % of the field, 10–16° of declination) at the Roccaraso and Santa Margarida pads:
+tests/env/test_magnetic.py.
 """
 
 from __future__ import annotations
 
 import datetime
 import functools
-import math
 import tomllib
 from importlib import resources
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-from ppigrf.ppigrf import RE, WGS84_a, WGS84_e2, read_shc, shc_fn_igrf14
+from ppigrf.ppigrf import geod2geoc, igrf_gc, read_shc, shc_fn_igrf14
 
 from ..math import Vec3
-from ..pytree import pytree_dataclass, static_field
+from ..pytree import pytree_dataclass
 
 IGRF13_DIPOLE = resources.files("rocketmc") / "data" / "igrf" / "igrf13_dipole.toml"
 
@@ -86,11 +86,12 @@ def site_field_ned(
     return np.array([b.x, b.y, b.z], dtype=float)
 
 
-def _ned_axes(lat, lon):
-    """(3, 3) rows: north, east, down at a latitude and longitude [rad], in Earth-centred axes."""
-    sin_lat, cos_lat, sin_lon, cos_lon = jnp.sin(lat), jnp.cos(lat), jnp.sin(lon), jnp.cos(lon)
-    return jnp.array([[-sin_lat * cos_lon, -sin_lat * sin_lon, cos_lat], [-sin_lon, cos_lon, 0.0 * lat],
-                      [-cos_lat * cos_lon, -cos_lat * sin_lon, -sin_lat]])  # fmt: skip
+def _ned_axes(lat, lon, xp=jnp):
+    """(3, 3) rows: north, east, down at a latitude and longitude [rad], in Earth-centred axes (``xp``: jax.numpy,
+    or numpy for the host's)."""
+    sin_lat, cos_lat, sin_lon, cos_lon = xp.sin(lat), xp.cos(lat), xp.sin(lon), xp.cos(lon)
+    return xp.array([[-sin_lat * cos_lon, -sin_lat * sin_lon, cos_lat], [-sin_lon, cos_lon, 0.0 * lat],
+                     [-cos_lat * cos_lon, -cos_lat * sin_lon, -sin_lat]])  # fmt: skip
 
 
 def site_field_gradient(latitude_deg, longitude_deg, altitude_m, decimal_year: float | None = None):
@@ -115,20 +116,11 @@ def site_field_gradient(latitude_deg, longitude_deg, altitude_m, decimal_year: f
 IGRF14_TABLE = shc_fn_igrf14
 """ppigrf's IGRF-14 coefficient table (.shc): main-field models every 5 years 1900.0–2025.0 and 2030.0, the 2025.0
 model moved by the predictive secular variation (data/igrf/SOURCE.md)."""
-IGRF_REFERENCE_RADIUS_M = 1e3 * RE
-WGS84_A_M, WGS84_E2 = 1e3 * WGS84_a, WGS84_e2
-"""The WGS84 ellipsoid's equatorial radius [m] and first eccentricity squared (ppigrf's, which it converts geodetic
-coordinates with)."""
-
-
-@pytree_dataclass
-class IgrfCoefficients:
-    """Gauss coefficients g_nm, h_nm [nT] of one date, in ppigrf's order of (degree, order) (``degree``, ``order``)."""
-
-    g_nt: jnp.ndarray
-    h_nt: jnp.ndarray
-    degree: tuple = static_field()
-    order: tuple = static_field()
+GRADIENT_STEP_M = 25.0
+"""The half step [m] of the gradient's central differences. Their truncation, h²/6 of the field's third derivative,
+is ≈ 3.3 (h/r)² of the gradient for the dominant dipole (B ∝ r⁻³): 8e-14 h² [m⁻²]; ppigrf's rounding, ~1e-15 of |B|
+(~50 µT) over 2h against a gradient of ~0.02 nT/m, is ~2.5e-9 m / h of it (both measured against the exact gradient
+of a dipole table, tests/env/test_magnetic.py). Their sum is least, ~1e-10 of the gradient, near h = 25 m."""
 
 
 @functools.cache
@@ -138,66 +130,41 @@ def igrf_validity(table: str = IGRF14_TABLE) -> tuple[datetime.date, datetime.da
     return g.index[0].date(), g.index[-1].date()
 
 
-def igrf_coefficients(date: datetime.date, table: str = IGRF14_TABLE) -> IgrfCoefficients:
-    """The coefficients at 0 h UTC of ``date``, linear in time between the table's models (as ppigrf interpolates
-    them); ValueError outside the table's dates."""
-    g, h = read_shc(table)
-    first, last = igrf_validity(table)
-    if not first <= date <= last:
-        raise ValueError(f"IGRF: the date {date.isoformat()} is outside the model's {first.isoformat()} to {last.isoformat()}")
-    days = lambda t: (t - datetime.datetime(1900, 1, 1)).total_seconds() / 86400.0  # noqa: E731
-    at, models = days(datetime.datetime(date.year, date.month, date.day)), [days(t) for t in g.index.to_pydatetime()]
-    g_nt, h_nt = (np.array([np.interp(at, models, c[key].to_numpy(float)) for key in g.columns]) for c in (g, h))
-    degree, order = zip(*g.columns)
-    return IgrfCoefficients(jnp.asarray(g_nt), jnp.asarray(h_nt), degree, order)
-
-
-def _igrf_potential(c: IgrfCoefficients, point_m):
-    """The IGRF's scalar potential V [nT·m] at an Earth-centred point [m] (x to 0° E on the equator, z north):
-    V = a Σ_n (a/r)^(n+1) Σ_m (g_nm cos mφ + h_nm sin mφ) P_nm(cos θ), P_nm Schmidt semi-normalised."""
-    radius = jnp.linalg.norm(point_m)
-    cos_t, sin_t = point_m[2] / radius, jnp.hypot(point_m[0], point_m[1]) / radius
-    phi = jnp.arctan2(point_m[1], point_m[0])
-    n_max = max(c.degree)
-    p = {(0, 0): jnp.ones_like(cos_t)}
-    for n in range(1, n_max + 1):  # Schmidt semi-normalised associated Legendre functions by recursion
-        p[n, n] = sin_t * p[n - 1, n - 1] * (1.0 if n == 1 else math.sqrt((2 * n - 1) / (2 * n)))
-        for m in range(n):
-            below = p[n - 2, m] * math.sqrt((n - 1) ** 2 - m**2) if n - 2 >= m else 0.0
-            p[n, m] = ((2 * n - 1) * cos_t * p[n - 1, m] - below) / math.sqrt(n**2 - m**2)
-    ratio = IGRF_REFERENCE_RADIUS_M / radius
-    terms = [ratio ** (n + 1) * (c.g_nt[k] * jnp.cos(m * phi) + c.h_nt[k] * jnp.sin(m * phi)) * p[n, m]
-             for k, (n, m) in enumerate(zip(c.degree, c.order))]  # fmt: skip
-    return IGRF_REFERENCE_RADIUS_M * sum(terms)
-
-
-def geodetic_to_ecef_m(latitude_rad, longitude_rad, height_m):
-    """The Earth-centred point [m] of a geodetic latitude, longitude [rad] and height above the WGS84 ellipsoid [m]."""
-    sin_lat = jnp.sin(latitude_rad)
-    normal = WGS84_A_M / jnp.sqrt(1.0 - WGS84_E2 * sin_lat**2)
-    across = (normal + height_m) * jnp.cos(latitude_rad)
-    return jnp.stack([across * jnp.cos(longitude_rad), across * jnp.sin(longitude_rad),
-                      (normal * (1.0 - WGS84_E2) + height_m) * sin_lat])  # fmt: skip
+def _igrf_in_axes(points_m: np.ndarray, date: datetime.date, table: str, axes: np.ndarray) -> np.ndarray:
+    """ppigrf's field [nT] (n, 3) at Earth-centred points [m] (n, 3) (x to 0° E on the equator, z north) at 0 h UTC
+    of ``date``, in the axes whose rows (in Earth-centred axes) are ``axes`` (3, 3)."""
+    radius = np.linalg.norm(points_m, axis=1)
+    theta, phi = np.arccos(points_m[:, 2] / radius), np.arctan2(points_m[:, 1], points_m[:, 0])
+    at = datetime.datetime(date.year, date.month, date.day)
+    radial, south, east = (b[0] for b in igrf_gc(radius / 1e3, np.degrees(theta), np.degrees(phi), at, coeff_fn=table))
+    sin_t, cos_t, sin_p, cos_p = np.sin(theta), np.cos(theta), np.sin(phi), np.cos(phi)
+    spherical = np.stack([np.stack([sin_t * cos_p, sin_t * sin_p, cos_t], axis=1),  # radial, south, east unit vectors
+                          np.stack([cos_t * cos_p, cos_t * sin_p, -sin_t], axis=1),
+                          np.stack([-sin_p, cos_p, np.zeros_like(sin_p)], axis=1)], axis=1)  # fmt: skip
+    return np.einsum("nk,nkj,ij->ni", np.stack([radial, south, east], axis=1), spherical, axes)
 
 
 @functools.lru_cache(maxsize=16)
 def igrf_site_field_gradient(latitude_deg, longitude_deg, altitude_m, date: datetime.date, table: str = IGRF14_TABLE):
     """(the IGRF-14 field (or ``table``'s) [T] at a site given in degrees at 0 h UTC of ``date``, its derivative along
     an offset from there [T/m] (3, 3)), both in the site's NED axes (geodetic: down along the ellipsoid's normal; the
-    flat Earth's), as numpy arrays: B = −∇V at the offset point, by automatic differentiation (the gradient is −V's
-    Hessian: symmetric and traceless). The altitude is taken above the ellipsoid (the geoid is within ~100 m of it:
-    ~2 nT). Evaluated eagerly (~2 s; compiled, XLA takes minutes over the unrolled degree-13 sums) and cached
-    (read-only arrays)."""
-    with jax.ensure_compile_time_eval():  # the site's numbers: computed once on the host, even under jit
-        coefficients = igrf_coefficients(date, table)
-        lat, lon = np.radians(latitude_deg), np.radians(longitude_deg)
-        site, centre = _ned_axes(lat, lon), geodetic_to_ecef_m(lat, lon, altitude_m)
-
-        def field_t(offset_n):
-            return -1e-9 * site @ jax.grad(_igrf_potential, argnums=1)(coefficients, centre + site.T @ offset_n)
-
-        origin = jnp.zeros(3)
-        field, gradient = np.array(field_t(origin), dtype=float), np.array(jax.jacfwd(field_t)(origin), dtype=float)
+    flat Earth's), as numpy arrays, from ppigrf's own evaluation (``igrf_gc``; the coefficients linear in time
+    between the table's models): the field at the site, and the gradient by central differences over
+    ±``GRADIENT_STEP_M`` along the site's axes, each point's field turned into them. The site goes onto Earth-centred
+    axes by ppigrf's ``geod2geoc``, its altitude taken above the ellipsoid (the geoid is within ~100 m of it: ~2 nT).
+    ValueError outside the table's dates. ~0.03 s; cached (read-only arrays)."""
+    first, last = igrf_validity(table)
+    if not first <= date <= last:
+        raise ValueError(f"IGRF: the date {date.isoformat()} is outside the model's {first.isoformat()} to "
+                         f"{last.isoformat()}")  # fmt: skip
+    colatitude_deg, radius_km, _, _ = geod2geoc(np.array([latitude_deg]), np.array([altitude_m / 1e3]), 0.0, 0.0)
+    theta, lon = np.radians(colatitude_deg.item()), np.radians(longitude_deg)
+    sin_t, cos_t = np.sin(theta), np.cos(theta)
+    centre_m = 1e3 * radius_km.item() * np.array([sin_t * np.cos(lon), sin_t * np.sin(lon), cos_t])
+    site = _ned_axes(np.radians(latitude_deg), lon, np)
+    offsets = GRADIENT_STEP_M * np.concatenate([np.zeros((1, 3)), np.eye(3), -np.eye(3)])  # the site, then ±h per axis
+    b = 1e-9 * _igrf_in_axes(centre_m + offsets @ site, date, table, site)
+    field, gradient = b[0], (b[1:4] - b[4:7]).T / (2.0 * GRADIENT_STEP_M)
     for cached in (field, gradient):  # shared by every caller: read-only
         cached.setflags(write=False)
     return field, gradient
