@@ -69,12 +69,13 @@ def test_none_row_is_every_sensor_truth_only(campaign, flown):
 
 
 def test_a_source_that_is_off_changes_nothing(campaign, flown):
-    """The barometer (its update is off in the filters) and the canard feedback (read by nothing) are reported,
-    not flown; flying the barometer alone (every other sensor off) gives the 'none' row's flights bit for bit."""
+    """The barometer (its update is off in the filters) and the thesis's perfect canard feedback are reported, not
+    flown; flying the barometer alone (every other sensor off) gives the 'none' row's flights bit for bit."""
     summary, rows = flown
     for name in ("barometer", "canard_feedback"):
         assert rows[name].campaign is None and rows[name].outputs is None
-        assert rows[name].reason == "not read by navigation = 'filters': the same flights as 'none'"
+    assert rows["barometer"].reason == "not read by navigation = 'filters': the same flights as 'none'"
+    assert rows["canard_feedback"].reason.startswith("already perfect (no error term")
     others = {f"avionics.{sensor}.truth_only": True for sensor in SENSORS if sensor != "barometer"}
     assert _same_bits(_flights(campaign.with_overrides(values=others)), rows["none"].outputs)
     gyroscope = rows["gyroscope"]

@@ -64,10 +64,10 @@ IDENTITY = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
 
 def sensor_read(config: CampaignConfig, sensor: str) -> bool:
     """Whether the controller's navigation reads ``sensor`` (gnc/navigation.py): on raw sensors ("sensors") the
-    gyroscope, the GNSS and the accelerometer (liftoff); on the filters also the magnetometer and, with its update
-    on, the barometer. Nothing reads the canard feedback."""
+    gyroscope, the GNSS, the accelerometer (liftoff) and the canard feedback (the LQI's actuator states); on the
+    filters also the magnetometer and, with its update on, the barometer."""
     navigation = config.gnc.navigation
-    if sensor in ("accelerometer", "gyroscope", "gnss"):
+    if sensor in ("accelerometer", "gyroscope", "gnss", "canard_feedback"):
         return navigation in ("sensors", "filters")
     if sensor == "magnetometer":
         return navigation == "filters"
