@@ -1,5 +1,5 @@
 """``rocketmc bench``: bad arguments, the packaged campaign, float64 flying float32's realizations,
-the impact comparison. The issue's timing ratios are in tests/test_performance.py."""
+the impact comparison. The project's timing ratios are in tests/test_performance.py."""
 
 import json
 import os

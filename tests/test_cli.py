@@ -215,7 +215,7 @@ def _subcommands(parser, words=()):
 
 
 def test_options_are_spelled_the_same_everywhere():
-    """Issue 19.4: one meaning (argparse's dest) has one spelling in every subcommand and one spelling one
+    """One meaning (argparse's dest) has one spelling in every subcommand and one spelling one
     meaning, except the old spellings kept (cli.OLD_SPELLINGS, each after the current one); a folder option's
     name ends in -dir, and only those take a DIR."""
     from rocketmc.cli import OLD_SPELLINGS, build_parser
@@ -298,7 +298,7 @@ def test_budget_bad_input_exit_2(tmp_path, capsys):
 
 
 def test_report_of_an_unstable_rocket(tmp_path, capsys):
-    """Acceptance (issue 19): campaigns/unstable_rocket.toml (no fins) tumbles; report shows its impacts,
+    """Acceptance: campaigns/unstable_rocket.toml (no fins) tumbles; report shows its impacts,
     counts and statuses: every flight failed with status 3, each with an impact point, drawn apart; run warned
     of the negative static margin before flying (even with --quiet) and the report repeats it from the file."""
     out, png = tmp_path / "unstable.h5", tmp_path / "unstable.png"

@@ -1,4 +1,4 @@
-"""The CLI's one error path (issue 15, classes 5 and 6 and the options around them): every failure
+"""The CLI's one error path: every failure
 a user can cause is one line ``rocketmc: error: ...`` naming the option, field or file, exit code 2,
 nothing printed before it and no file written. Result files are made here with h5py (the contract
 of docs/conventions.md), so nothing is flown."""
@@ -186,7 +186,7 @@ def test_validate_plots_into_a_file(tmp_path, capsys):
     one_line(capsys, ["validate", "roccaraso-2021", "--plot", str(tmp_path / "a_file" / "plots")], "a_file")
 
 
-# --- data files are never overwritten without --force (issue 19, part 4.1) -----------------------
+# --- data files are never overwritten without --force -----------------------------------------
 
 def test_run_refuses_an_existing_result_file(tmp_path, capsys):
     """An existing --out is kept byte for byte; the line names it and the two ways on."""

@@ -1,5 +1,5 @@
-"""The performance ratios (issues 6 and 16), measured together in one run on one machine, never absolute times;
-issue 17's sensors cost is printed (``-s``), its bound of 1.3x not met yet (docs/performance.md).
+"""The performance ratios (docs/performance.md), measured together in one run on one machine, never absolute times;
+the sensors' cost is printed (``-s``), its bound of 1.3x not met yet (docs/performance.md).
 
 Marked ``performance``: ``make test`` runs them alone after the parallel suite, since another test
 process on the same cores would bias the timings. Each measurement (``rocketmc.bench.measure``) runs in
@@ -25,7 +25,7 @@ ROUNDS = 10
 long (a shared host): one 1024-flight batch's CPU time varies by up to 50 % from round to round, on two threads
 as on one (measured: simplified 4.3-6.7 ms per flight, interpolated 5.8-9.1 ms, on one thread). The best
 rounds agree within ~5 % on one thread; the ratio of bests was 1.34 there, 1.39-1.50 on two threads, where the
-issue's bound 1.5 failed CI once (1.502)."""
+project's bound 1.5 failed CI once (1.502)."""
 CAMPAIGN = CAMPAIGNS / "lynx_nominal.toml"
 
 
@@ -47,7 +47,7 @@ def cost():
 
 
 def test_vmapped_batch_at_least_20x_faster_per_flight_than_a_loop(measured):
-    # 20x is the issue's bound, and the reason to vectorise: a batch spreads XLA's per-operation cost
+    # 20x is the project's bound, and the reason to vectorise: a batch spreads XLA's per-operation cost
     # over the SIMD lanes and flies on every core. A regression that serialises the batch (a lost
     # shard_map, a per-flight loop inside it, a host callback) brings it near the loop's cost.
     ratio = measured["loop_over_batch"]
@@ -55,14 +55,14 @@ def test_vmapped_batch_at_least_20x_faster_per_flight_than_a_loop(measured):
 
 
 def test_interpolated_costs_at_most_1_5x_the_simplified(cost):
-    # 1.5x is the issue's bound on the tables' cost: the interpolated model must stay affordable for
-    # whole campaigns (the thesis's cost 30x its simplified one, ../shared/LYNX.md).
+    # 1.5x is the project's bound on the tables' cost: the interpolated model must stay affordable for
+    # whole campaigns (the thesis's cost 30x its simplified one, docs/lynx.md).
     ratio = cost["interpolated_over_simplified"]
     assert ratio <= 1.5, f"the interpolated aerodynamics cost {ratio:.2f}x the simplified per flight"
 
 
 def test_closed_loop_flies_at_least_0_7x_the_open_loops_flights_per_second(cost):
-    # 0.7x is issue 16's bound: guidance, the gain lookup, u = −Kx and the servos' closed form at each RK4
+    # 0.7x is the closed loop's bound: guidance, the gain lookup, u = −Kx and the servos' closed form at each RK4
     # stage, with perfect navigation, must not make the controller a luxury in a campaign. A per-step
     # host callback, a Python branch that recompiles, or small-matrix algebra under vmap would break it.
     flights_per_s = 1.0 / cost["closed_over_open_loop"]

@@ -1,4 +1,4 @@
-"""The navigation filters replayed on the real Roccaraso 2021 log (issue 18's acceptance): ``python
+"""The navigation filters replayed on the real Roccaraso 2021 log (the navigation's acceptance): ``python
 docs/scripts/navigate_roccaraso.py`` replays the log (``analysis.replay``, as ``rocketmc navigate``) with the site,
 rail and [gnc.filters] tuning of data/campaigns/lynx_roccaraso_2021.toml (the thesis's tuning) and the variants of
 ``TUNINGS``, prints the estimates against the log's barometric height and GNSS velocity per window, and writes
@@ -67,7 +67,7 @@ TUNINGS = {
 from 10.5 s, field direction σ_b 2); σ_b 200: the magnetometer all but ignored, the gyroscope trusted."""
 NAS_BAROMETER_R_PA2 = 4.37
 """Skyward's NAS (2021) barometer update: a static pressure measurement through the ISA with R = 4.37 Pa²
-(../shared/GNC.md §3; boardcore's ``NAS::correctBaro`` innovates in pascals)."""
+(docs/gnc.md §3; boardcore's ``NAS::correctBaro`` innovates in pascals)."""
 PAD_PRESSURE_PA = 85_690.0  # the MS5803's, as the replay takes it (printed by ``main``)
 AS_FLOWN_ALTITUDE_STD_M = float(pressure_height_m(PAD_PRESSURE_PA - math.sqrt(NAS_BAROMETER_R_PA2), PAD_PRESSURE_PA))
 """The NAS's barometer σ as a height [m] at the pad (√4.37 Pa over ρg there: 0.20 m; 0.23 m at apogee, the air

@@ -1,4 +1,4 @@
-"""Issue 18's filter acceptance on simulated flights: the thesis's full-GNC ballistic case from 1 s
+"""The navigation filters' acceptance on simulated flights: the thesis's full-GNC ballistic case from 1 s
 (campaigns/lynx_ballistic_gnc_1s.toml), N = 1000, its thesis sensors, once with the thesis's filter tuning and
 once with the position/velocity filter's process noise calibrated for consistency.
 

@@ -1,4 +1,4 @@
-"""Allan deviations of 2-hour static records of the accelerometer and gyroscope of each part (issue 17's acceptance):
+"""Allan deviations of 2-hour static records of the accelerometer and gyroscope of each part (the sensors' acceptance):
 ``python docs/scripts/sensor_allan.py [SECONDS]`` prints, per part and axis, the white-noise level N at τ = 1 s and
 the rate-random-walk level K (fitted by ``analysis.allan.noise_terms``) against the configured values, with the
 fitted slopes, and writes docs/figures/sensor_allan.png.

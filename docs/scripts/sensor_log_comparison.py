@@ -1,4 +1,4 @@
-"""The simulated as-flown Lynx sensor log against the real Roccaraso 2021 log (issue 17's acceptance):
+"""The simulated as-flown Lynx sensor log against the real Roccaraso 2021 log (the sensors' acceptance):
 ``python docs/scripts/sensor_log_comparison.py [REALIZATION]`` flies campaigns/lynx_roccaraso_2021_sensors.toml
 (`rocketmc sensors simulate`), prints each channel's high-frequency noise in both logs through the coast (burnout
 to apogee) and at rest after landing, and writes docs/figures/sensor_log_roccaraso.png (channel by channel) and

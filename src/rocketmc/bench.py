@@ -5,10 +5,10 @@
 - float32 against float64: their speeds, and the distances between the impact points of the same
   realizations flown in both;
 - ratios timed together in one process: the vmapped batch against single flights in a loop (every
-  core; issue 6); in another, on one core and one thread, the costs per flight: the interpolated
-  aerodynamics against the simplified (issue 6), the closed loop (perfect navigation) against the
-  same flights with the controller off (issue 16), the closed loop on raw sensors against it (issue 17), the full
-  GNC (navigation filters) against the controller off (issue 18).
+  core); in another, on one core and one thread, the costs per flight: the interpolated
+  aerodynamics against the simplified, the closed loop (perfect navigation) against the
+  same flights with the controller off, the closed loop on raw sensors against it, the full
+  GNC (navigation filters) against the controller off (their bounds: docs/performance.md).
 
 Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
 resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
@@ -95,7 +95,7 @@ def _batch() -> int:
 
 
 def ratios(campaign, repeats: int = 3) -> dict:
-    """Issue 6's batch ratio on ``campaign``, simplified model, on every core: seconds per flight [s] of
+    """The batch-against-loop ratio on ``campaign``, simplified model, on every core: seconds per flight [s] of
     ``LOOP_FLIGHTS`` single flights in a loop and of a vmapped batch (``_batch``), timed together
     (``_timed_together``); ``loop_over_batch``."""
     simplified = campaign.with_overrides(aero_model="simplified")
@@ -108,7 +108,7 @@ def ratios(campaign, repeats: int = 3) -> dict:
 
 
 def costs(campaign, repeats: int = 3) -> dict:
-    """The cost ratios of issues 6, 16, 17 and 18 on ``campaign``, per flight of vmapped batches (``_batch``), timed
+    """The cost ratios of docs/performance.md on ``campaign``, per flight of vmapped batches (``_batch``), timed
     together: the interpolated aerodynamics against the simplified (controller off), the closed loop (the
     campaign's [gnc] or its defaults, perfect navigation) against the same flights with the controller off
     (simplified), the closed loop on raw sensors (the campaign's [avionics] or the thesis's parts)

@@ -1,10 +1,10 @@
-"""Canard mixing against the thesis's matrix (LYNX.md), written out independently with numpy."""
+"""Canard mixing against the thesis's matrix (docs/lynx.md), written out independently with numpy."""
 
 import numpy as np
 
 from rocketmc.aero.canards import allocate, mix
 
-THESIS_MIXING = np.array(  # rows: yaw, pitch, roll, squeeze; columns: delta 1..4 (LYNX.md)
+THESIS_MIXING = np.array(  # rows: yaw, pitch, roll, squeeze; columns: delta 1..4 (docs/lynx.md)
     [[-0.5, 0, 0.5, 0], [0, 0.5, 0, -0.5], [-0.25, -0.25, -0.25, -0.25], [-0.25, 0.25, -0.25, 0.25]]
 )
 

@@ -38,7 +38,7 @@ def test_matches_scipy_on_random_points(lynx, lynx_mat):
         lynx, (np.deg2rad(points[:, 0]), points[:, 1], np.deg2rad(points[:, 2]), points[:, 3])
     )
     # Same multilinear formula; the deg->rad conversion shifts the cell fractions by ~1 ulp, and
-    # |coefficients| <= ~1e3 (CMQ, CLNR), so the differences are ~1e-13: 1e-12 is the acceptance.
+    # |coefficients| <= ~1e3 (CMQ, CLNR), so the differences are ~1e-13: 1e-12 is the project's acceptance.
     np.testing.assert_allclose(values, reference(points), rtol=1e-12, atol=1e-12)
     assert not np.any(out_of_range)
 

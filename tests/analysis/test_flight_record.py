@@ -74,7 +74,7 @@ def test_static_margin_against_the_model(campaign, record):
 
 
 def test_centre_of_pressure_of_the_linear_model(campaign):
-    # LYNX.md's linear model: CNα 24.0744, Cmα −37.2959 per rad about the reference point, d = 0.15 m
+    # docs/lynx.md's linear model: CNα 24.0744, Cmα −37.2959 per rad about the reference point, d = 0.15 m
     aero = nominal_params(campaign.with_overrides(aero_model="linear")).rocket.aero
     air = AirData(*(jnp.asarray(x) for x in (100.0, 0.0, 0.0, 0.3, 6000.0, 1.1, 1500.0)))
     x_cp = float(centre_of_pressure_at(aero, air, jnp.asarray(0.0)))

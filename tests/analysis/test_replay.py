@@ -4,7 +4,7 @@ One simulated flight (the nominal Lynx with the thesis's sensors but a NEO-M9N r
 flown once with its avionics bus and true state recorded, and its log built as ``rocketmc sensors simulate`` builds
 it (in memory). Against it: the replay of the log is the filter fed from the flight's own bus (the log's plumbing:
 timing, freshness, units, latitude/longitude); the replayed estimates track the truth; the barometer's lock-out above
-a Mach number. On the real Roccaraso log: the barometer-on descent (the issue's acceptance), the pitot's static port
+a Mach number. On the real Roccaraso log: the barometer-on descent (the navigation's acceptance), the pitot's static port
 as the barometer, the CLI's outputs and errors.
 """
 
@@ -295,7 +295,7 @@ def _rms(out: str) -> dict[str, float]:
 
 
 def test_navigate_as_flown_meets_the_real_log_targets(tmp_path, capsys):
-    """Issue 18's targets on the real Roccaraso log through ``rocketmc navigate`` with the as-flown tuning's knobs
+    """The navigation's targets on the real Roccaraso log through ``rocketmc navigate`` with the as-flown tuning's knobs
     (docs/scripts/navigate_roccaraso.py: the pitot's static port at Skyward's NAS σ, R = 4.37 Pa², 0.2 m; the
     NEO-M9N's fixes on every axis from liftoff at 5 m, 0.5 m/s; the gyroscope trusted from the first accelerometer
     sample's attitude): the height within 10 m RMS of the barometric height through the coast and the descent
@@ -347,7 +347,7 @@ def test_navigate_refuses_what_it_cannot_replay(tmp_path, capsys):
 
 
 def test_real_log_descent_height_with_the_barometer():
-    """The acceptance on the real Roccaraso log (docs/validation.md, issue 18): with the barometer on, the estimated
+    """The acceptance on the real Roccaraso log (docs/validation.md): with the barometer on, the estimated
     height follows the barometric height within 10 m RMS from apogee to landing (measured: 2.2 m); off, the thesis's
     filter drifts by tens of metres (measured: 63 m), which the barometer's update is there to remove."""
     campaign = load_campaign(ROOT / "src" / "rocketmc" / "data" / "campaigns" / "lynx_roccaraso_2021.toml")

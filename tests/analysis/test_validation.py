@@ -1,7 +1,7 @@
-"""The simulation against the real Lynx flights: issue 5's acceptance, so that a change in the physics
+"""The simulation against the real Lynx flights: the acceptance of docs/validation.md, so that a change in the physics
 that breaks agreement with reality turns CI red.
 
-Bounds (issue 5): apogee within 3 % and its time within 0.7 s, the axial specific force in the burn
+Bounds (docs/validation.md's table): apogee within 3 % and its time within 0.7 s, the axial specific force in the burn
 within 10 % RMS, the descent rates under each canopy within 10 %, the EuRoC apogee within 3 % of
 3076 m. They are wider than the measurements' own errors (baro noise ~1 m, the apogee time to
 ±0.05 s, accelerometer ~1 %) because the model's inputs are not measured: the thrust curve is the

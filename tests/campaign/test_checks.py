@@ -1,4 +1,4 @@
-"""The warnings before and after flying (issue 19, parts 4.2 and 4.3): a statically unstable nominal rocket
+"""The warnings before and after flying: a statically unstable nominal rocket
 and flights beyond the aerodynamic tables' range or the build-up's subsonic theory."""
 
 from __future__ import annotations

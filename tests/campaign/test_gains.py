@@ -1,4 +1,4 @@
-"""The LQI gain schedule a campaign designs at set-up (campaign/gains.py, GNC.md §5): the plant of each
+"""The LQI gain schedule a campaign designs at set-up (campaign/gains.py, docs/gnc.md §5): the plant of each
 grid point against a hand-built one and against the nonlinear flight's own derivatives, the stability
 of the default Lynx schedule for each aerodynamic model, the flight estimate behind the grid check,
 and the set-up's fingerprint."""
@@ -54,7 +54,7 @@ def simplified(linear):
 
 
 def test_linear_schedule_is_the_thesis_plant_at_burnout(linear):
-    """A grid point of the linear Lynx against GNC.md §5's plant written by hand: LYNX.md's coefficients
+    """A grid point of the linear Lynx against docs/gnc.md §5's plant written by hand: docs/lynx.md's coefficients
     (force damping 154 per ω·d/V), the Lynx at burnout (18.362 kg, Ixx 0.06, Iyy 6.436 kg·m², its CG on the
     moment reference, so no shift), S 0.01767 m², d 0.15 m, ρ of the ISA at the grid altitude above
     Roccaraso, ω_a = 1/0.0769 s, dt 0.02 s, ZOH, the weights flown, the integrators augmented with the gains

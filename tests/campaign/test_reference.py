@@ -1,4 +1,4 @@
-"""docs/campaign_reference.md is the schema's reference, regenerated (issue 19, part 4.5)."""
+"""docs/campaign_reference.md is the schema's reference, regenerated."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Fuzzed campaigns (issue 15): every number finite and in its physical range, every value a dispersion
+"""Fuzzed campaigns: every number finite and in its physical range, every value a dispersion
 can draw valid, the name a label, broken input files refused: each as one ConfigError line naming the
 field, checked at load time. No flight is flown."""
 

@@ -1,5 +1,5 @@
 """Partial runs that must not be resumed, result files that cannot be written, and names that are
-not paths (issue 15, classes 1, 3, 4 and 6): each refusal is one line naming the file or field,
+not paths: each refusal is one line naming the file or field,
 exit code 2, and leaves every file as it was; what can be completed is completed to the same bits.
 
 One small run (lynx_ballistic, 24 flights in 3 chunks) is flown once per

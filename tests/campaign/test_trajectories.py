@@ -1,4 +1,4 @@
-"""Trajectories kept by a campaign run (``run --trajectories``, issue 19 item 1): the flight record of each chosen
+"""Trajectories kept by a campaign run (``run --trajectories``): the flight record of each chosen
 realization decimated, bit for bit, consistent with its ``/outputs`` row, bounded in rows; bad choices refused in
 one line with nothing left; a killed run resumes to the same file; a run without them is unchanged."""
 

@@ -358,7 +358,7 @@ def test_igrf_dates():
 
 
 def test_igrf_differs_from_the_dipole_at_roccaraso():
-    # GNC.md: the dipole's unit vector (0.478, −0.107, 0.872) against the full IGRF's (0.525, 0.036, 0.850), 8.8° apart
+    # docs/gnc.md: the dipole's unit vector (0.478, −0.107, 0.872) against the full IGRF's (0.525, 0.036, 0.850), 8.8° apart
     dipole = site_field_ned(*SITES["roccaraso"])
     igrf, _ = igrf_site_field_gradient(*SITES["roccaraso"], LAUNCH_DAY)
     np.testing.assert_allclose(dipole / np.linalg.norm(dipole), [0.478, -0.107, 0.872], rtol=0, atol=6e-4)

@@ -1,4 +1,4 @@
-"""The day's atmosphere (issue 19): the readers against the raw files read here independently, the profile's
+"""The day's atmosphere: the readers against the raw files read here independently, the profile's
 interpolation against the ISA, the flight in an ISA-equal profile against the ISA flight, a weather campaign
 end to end, and bad weather input refused in one line."""
 

@@ -1,4 +1,4 @@
-"""The attitude MEKF (gnc/attitude_filter.py, GNC.md §2) against independent references: Φ = expm(F T) and Q by
+"""The attitude MEKF (gnc/attitude_filter.py, docs/gnc.md §2) against independent references: Φ = expm(F T) and Q by
 Van Loan's method (scipy), the quaternion step against scipy's ODE solver, the covariance algebra against
 numpy's matrices (Φ P Φᵀ + Q, the gain, the standard-form update), TRIAD against scipy's rotations, and a
 Monte Carlo whose average NEES must sit in its chi-square band: the filter is consistent with its own model.
@@ -36,7 +36,7 @@ from rocketmc.math.vectors import Quat, Vec3
 
 T = 0.02
 THESIS = AttitudeTuning()
-FIELD_N = Vec3(0.478, -0.107, 0.872)  # the dipole's unit field at Roccaraso (GNC.md §2), NED
+FIELD_N = Vec3(0.478, -0.107, 0.872)  # the dipole's unit field at Roccaraso (docs/gnc.md §2), NED
 
 
 def skew(w) -> np.ndarray:

@@ -28,7 +28,7 @@ ROUND = 1e-14
 
 
 def thesis_point(speed, altitude_msl):
-    """GNC.md §5's thesis plant (m 22 kg, the linear coefficients of LYNX.md) at one design point."""
+    """docs/gnc.md §5's thesis plant (m 22 kg, the linear coefficients of docs/lynx.md) at one design point."""
     return design.PlantPoint(
         -24.0744, 154.0, 3.4045, 24.0744, 154.0, 3.4045, -19.0, 2.3963, -37.2959, -1813.0, 21.8445,
         37.2959, -1813.0, 21.8445, 22.0, 0.06, 6.437, math.pi * 0.15**2 / 4, 0.15, speed, design.density(altitude_msl),

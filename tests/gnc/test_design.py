@@ -1,7 +1,7 @@
-"""LQI gain design (GNC.md §5): the plant against LYNX.md's dimensional forces, ZOH against scipy.signal,
-the DARE against a Riccati iteration, GNC.md's reference gains for the thesis plant, and the gain schedule.
+"""LQI gain design (docs/gnc.md §5): the plant against docs/lynx.md's dimensional forces, ZOH against scipy.signal,
+the DARE against a Riccati iteration, docs/gnc.md's reference gains for the thesis plant, and the gain schedule.
 
-The thesis plant: m 22 kg, Ixx 0.06, Iyy 6.437 kg·m², S = π·0.15²/4, d 0.15 m, LYNX.md's linear
+The thesis plant: m 22 kg, Ixx 0.06, Iyy 6.437 kg·m², S = π·0.15²/4, d 0.15 m, docs/lynx.md's linear
 coefficients (force damping CY_r = CN_q = 154 per ω·d/V as the thesis writes it), dt 0.02 s, the
 weights flown (Q = diag(0, 0, 0, 5, 5, 0, 0, 0, 10, 10, 10), R = 100·I3).
 """
@@ -41,7 +41,7 @@ LYNX = dict(
 # into {v, r, u_y, e_r}, {w, q, u_p, e_q}, {p, u_r, e_p}; every other entry of K is structurally zero.
 CHANNELS = ((0, 4, 5, 10), (1, 3, 6, 9), (2, 7, 8))
 
-# GNC.md §5's reference gains (4 decimals): yaw row at (v, r, u_y, e_r), roll row at (p, u_r, e_p);
+# docs/gnc.md §5's reference gains (4 decimals): yaw row at (v, r, u_y, e_r), roll row at (p, u_r, e_p);
 # the pitch row is the yaw row with the sign of w flipped (at (w, q, u_p, e_q)).
 REFERENCES = {
     ("euler", 100.0, 1.2133): ((0.0132, 0.1011, 0.5017, -0.2955), (0.0358, 1.1791, -0.2710)),
@@ -59,7 +59,7 @@ def design(point, method, dt=THESIS_DT):
 
 
 def reference_matrix(yaw, roll):
-    """The (3, 11) gain GNC.md lists, zero where it lists nothing."""
+    """The (3, 11) gain docs/gnc.md lists, zero where it lists nothing."""
     k = np.zeros((3, 11))
     k[0, list(CHANNELS[0])] = yaw
     k[1, list(CHANNELS[1])] = (-yaw[0], *yaw[1:])
@@ -68,7 +68,7 @@ def reference_matrix(yaw, roll):
 
 
 def thesis_rhs(x, delta_cmd, speed, rho, c=LYNX, omega_a=THESIS_OMEGA_A):
-    """ẋ of the nonlinear lateral rigid body with LYNX.md's dimensional force and moment (q̄ = ½ρV²,
+    """ẋ of the nonlinear lateral rigid body with docs/lynx.md's dimensional force and moment (q̄ = ½ρV²,
     q_v = ½ρV; force damping q_v·S·d·C·ω, moment damping q_v·S·d·(d/2)·C·ω), axial speed held."""
     v, w, p, q, r, u_y, u_p, u_r = x
     s, d, m = c["area"], c["diameter"], c["mass"]
@@ -93,7 +93,7 @@ def thesis_rhs(x, delta_cmd, speed, rho, c=LYNX, omega_a=THESIS_OMEGA_A):
 
 
 def test_plant_is_the_jacobian_of_the_thesis_forces():
-    """A, B against central differences of LYNX.md's dimensional forces: pins the damping conventions
+    """A, B against central differences of docs/lynx.md's dimensional forces: pins the damping conventions
     (force per ω·d/V, moment per ω·d/(2V)) and the kinematic −u r, +u q terms."""
     speed, rho, h = 150.0, 1.1, 1e-6
     a, b = lqi_plant(thesis_point(speed, rho))
@@ -208,7 +208,7 @@ def test_reference_gains_of_gnc_md(method, speed, rho):
 
 @pytest.mark.parametrize(("method", "speed", "rho"), list(REFERENCES))
 def test_references_used_the_rounded_servo_bandwidth(method, speed, rho):
-    """With ω_a = 13 rad/s exactly, GNC.md's figures are reproduced to their rounding; with 1/0.0769
+    """With ω_a = 13 rad/s exactly, docs/gnc.md's figures are reproduced to their rounding; with 1/0.0769
     they are not (up to 5e-4 off), so this is where the references' small offsets come from."""
     k = design(thesis_point(speed, rho, omega_a=13.0), method).gain
     expected = reference_matrix(*REFERENCES[method, speed, rho])
@@ -220,7 +220,7 @@ def test_references_used_the_rounded_servo_bandwidth(method, speed, rho):
 
 @pytest.mark.parametrize("method", ["euler", "zoh"])
 def test_spectral_radius_of_gnc_md(method):
-    # GNC.md prints 0.99495 (5 decimals, ±5e-6) for both methods at 100 m/s.
+    # docs/gnc.md prints 0.99495 (5 decimals, ±5e-6) for both methods at 100 m/s.
     assert design(thesis_point(100.0, 1.2133), method).spectral_radius == pytest.approx(0.99495, abs=1e-5)
 
 

@@ -1,4 +1,4 @@
-"""Guidance (GNC.md §4) against closed forms: the parabolic reference, the tracking error χ and rotation axis
+"""Guidance (docs/gnc.md §4) against closed forms: the parabolic reference, the tracking error χ and rotation axis
 of a velocity turned by a known angle about a known axis, the rate limit, the roll law, the window, the
 rate-error integrators, and jit/vmap against eager bit for bit.
 
@@ -47,7 +47,7 @@ def test_reference_is_the_thesis_parabola():
     direction of the point mass with v_x = √(2 g0 H)/tan γ0 and vertical speed √(2 g0 H) − g0 (t − t0)."""
     p = GuidanceParams()
     assert float(p.apogee_m) == 1614.0 and float(p.t0_s) == 1.5 and float(p.gain) == 5.0
-    assert math.isclose(math.sqrt(2 * G0 * 1614.0), 177.92, abs_tol=5e-3)  # GNC.md's c1 [m/s], to its digits
+    assert math.isclose(math.sqrt(2 * G0 * 1614.0), 177.92, abs_tol=5e-3)  # docs/gnc.md's c1 [m/s], to its digits
     assert math.isclose(math.sqrt(2 * G0 * 1614.0) / math.tan(84 * DEG), 18.70, abs_tol=5e-3)  # v_x [m/s]
     d0 = reference_direction(p, None, p.t0_s)
     assert math.isclose(float(-d0.z), math.sin(84 * DEG), abs_tol=ROUND)

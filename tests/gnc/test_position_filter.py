@@ -1,4 +1,4 @@
-"""The position/velocity Kalman filter (GNC.md §3) against independent references: a plain 6-state numpy Kalman
+"""The position/velocity Kalman filter (docs/gnc.md §3) against independent references: a plain 6-state numpy Kalman
 filter (the decoupled per-axis form is exact), the closed form of the prediction with a constant acceleration,
 the discrete algebraic Riccati equation (scipy) for the steady state, and a Monte Carlo in which the truth follows
 the filter's own model, whose NEES must be chi-square distributed. Then grad and vmap.

@@ -1,4 +1,4 @@
-"""Both aerodynamic models fly the nominal Lynx to nearly the same apogee (issue 3's acceptance)."""
+"""Both aerodynamic models fly the nominal Lynx to nearly the same apogee (docs/validation.md's acceptance)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from rocketmc.sim.flight import Status, simulate_one
 def test_interpolated_and_simplified_apogees_within_2_percent(lynx_campaign):
     """The simplified model is the interpolated one linearised at zero angles; a nominal flight
     stays at small angles except on the rail and near apogee, so the apogees agree to ~0.5 %; the
-    2 % bound is the issue's acceptance."""
+    2 % bound is the project's acceptance (docs/validation.md)."""
     apogees = {}
     for model, kind in (("interpolated", TableAero), ("simplified", LinearAero)):
         campaign = lynx_campaign.with_overrides(aero_model=model)

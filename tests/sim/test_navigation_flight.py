@@ -33,7 +33,7 @@ from ..conftest import CAMPAIGNS
 N_PERIODS = 1000  # 20 s at 0.02 s: past the window (10 s after liftoff), burnout (~4 s) and apogee (~19 s)
 ATTITUDE_DEG, VELOCITY_MPS = 6.0, 2.0
 """Bounds on the thesis filters' errors through the ascent, measured 4.05° (near apogee: the roll about the field
-line is unobservable, GNC.md §2) and 1.10 m/s; what a frame or sign slip breaks by far."""
+line is unobservable, docs/gnc.md §2) and 1.10 m/s; what a frame or sign slip breaks by far."""
 TRUTH_ONLY = {"attitude_deg": 1.5, "position_m": 3.0, "velocity_mps": 1.2}
 """Bounds on the errors without sensor errors through the ascent, measured 0.91°, 2.05 m, 0.78 m/s: the
 accelerometer's sample held over the period lags the acceleration's jump at liftoff by one period (a·T ≈ 0.7 m/s,

@@ -134,7 +134,7 @@ LYNX_AS_FLOWN = RocketGeometry(
     nose=Nose("von_karman", 0.26),
     fins=(FinSet(3, 0.35, 0.12, 0.12, 0.23, 2.145, thickness_m=0.003),),
 )
-"""Skyward's Lynx as flown in 2021: 3 tail fins, no canards (LYNX.md; DATCOM deck FINSET1)."""
+"""Skyward's Lynx as flown in 2021: 3 tail fins, no canards (docs/lynx.md; DATCOM deck FINSET1)."""
 
 LYNX_CANARDS = dataclasses.replace(
     LYNX_AS_FLOWN,

@@ -2,7 +2,7 @@
 simulated one (``rocketmc sensors simulate``), both in ``analysis.sensor_log``'s format.
 
 What: the flight's own filters (``gnc.navigation.filter_step``: the MEKF and the position/velocity Kalman filter,
-GNC.md §2-3) run over the log as the avionics would have run them, at the IMU's 50 Hz ticks, and their estimates
+docs/gnc.md §2-3) run over the log as the avionics would have run them, at the IMU's 50 Hz ticks, and their estimates
 compared with what the log measured independently of them: the barometric height, the GNSS velocity and its
 direction.
 

@@ -109,7 +109,7 @@ def simulated_descent_rate(flight: pd.DataFrame, window) -> float:
 
 def validate_roccaraso(campaign: Campaign, reduction: FlightReduction) -> tuple[list[Check], pd.DataFrame]:
     """The campaign's nominal flight against the Roccaraso 2021 log: the checks (tolerances of
-    issue 5 where it sets them) and the simulated flight."""
+    docs/validation.md's table where it sets them) and the simulated flight."""
     r = reduction
     flight, times, _ = simulated_flight(campaign, r.landing_time_s + 20.0)
     measured_force = r.axial_specific_force
@@ -135,7 +135,7 @@ def validate_roccaraso(campaign: Campaign, reduction: FlightReduction) -> tuple[
 
 
 EUROC_2021_APOGEE_M = 3076.0
-"""The measured apogee of Lynx at EuRoC 2021 [m above the pad] (LYNX.md; no time series is public)."""
+"""The measured apogee of Lynx at EuRoC 2021 [m above the pad] (docs/lynx.md; no time series is public)."""
 
 
 def validate_euroc(campaign: Campaign) -> list[Check]:

@@ -626,7 +626,7 @@ class GuidanceConfig(_Strict):
 
 
 class ControlConfig(_Strict):
-    """The LQI design (GNC.md §5); fixed per campaign. Weights on the augmented state
+    """The LQI design (docs/gnc.md §5); fixed per campaign. Weights on the augmented state
     [v, w, p, q, r, u_y, u_p, u_r, e_p, e_q, e_r] and on the three virtual commands; the grid of axial
     speed [m/s] and altitude above the pad [m] the gains are designed on (interpolated in flight)."""
 
@@ -665,7 +665,7 @@ for 1 degree of freedom, 11.8 for 2, 16.3 for 4, 20.1 for 6."""
 
 
 class AttitudeFilterConfig(_Strict):
-    """The MEKF's tuning (GNC.md §2, ``gnc.attitude_filter``), the thesis's values as defaults: the gyro's white
+    """The MEKF's tuning (docs/gnc.md §2, ``gnc.attitude_filter``), the thesis's values as defaults: the gyro's white
     noise σ_v [deg/s/√s] and its bias's random walk σ_u [deg/s²/√s] (knobs about 10³ above the thesis gyro's own:
     the filter follows the magnetometer within ~0.3 s), the measured field direction's standard deviation [-] (a
     unit vector; the thesis's R = 4 I), the initial standard deviations of the attitude [deg] and gyro bias
@@ -684,7 +684,7 @@ class AttitudeFilterConfig(_Strict):
 
 
 class PositionFilterConfig(_Strict):
-    """The position/velocity Kalman filter's tuning (GNC.md §3, ``gnc.position_filter``), the thesis's values as
+    """The position/velocity Kalman filter's tuning (docs/gnc.md §3, ``gnc.position_filter``), the thesis's values as
     defaults: process noise on position [m/√s] and velocity [m/s/√s]; the GNSS fixes used from ``gnss_after_s``
     (simulation time [s]), on every axis ("all") or north and east only ("horizontal", Skyward's avionics),
     with their standard deviations N, E, D (the thesis's, de-weighted ~100×); the barometric height update (off in
@@ -701,7 +701,7 @@ class PositionFilterConfig(_Strict):
     gnss_velocity_std_mps: list[StdDeviation] = Field([50.0, 50.0, 70.0], min_length=3, max_length=3,
                                                       description="the GNSS velocity's std the filter assumes, N, E, D")
     barometer: bool = Field(False, description="the barometric height update")
-    # GNC.md's MS5803-class 50 Pa per sample over ρ·g: 4.2 m at sea level, 4.8 m at Lynx's 1.4 km pads (the thesis
+    # docs/gnc.md's MS5803-class 50 Pa per sample over ρ·g: 4.2 m at sea level, 4.8 m at Lynx's 1.4 km pads (the thesis
     # has no barometer update)
     altitude_std_m: StdDeviation = Field(5.0, description="the barometric height's std")
     initial_position_std_m: StdDeviation = Field(1.0, description="initial position std per axis (P0)")
@@ -738,7 +738,7 @@ class GncConfig(_Strict):
 
 
 DEFAULT_PART = "thesis"
-"""The part of a sensor no part is named for: the thesis's set provides every sensor (GNC.md §1)."""
+"""The part of a sensor no part is named for: the thesis's set provides every sensor (docs/gnc.md §1)."""
 SensorValue = Annotated[float, Field(ge=-MAX_SENSOR_VALUE, le=MAX_SENSOR_VALUE)]
 SensorSpread = Annotated[float, Field(ge=0, le=MAX_SENSOR_VALUE)]
 

@@ -1,4 +1,4 @@
-"""The LQI gain schedule of a campaign with a ``[gnc]`` section (GNC.md §5), designed once on the host
+"""The LQI gain schedule of a campaign with a ``[gnc]`` section (docs/gnc.md §5), designed once on the host
 when the campaign loads (``config.campaign_from_dict``, ``Campaign.with_overrides``).
 
 Each grid point (axial speed u [m/s], altitude) is ``gnc.design``'s linear plant built from the
@@ -132,7 +132,7 @@ def plant_point(
     aero: LinearAero, mass: MassProperties, speed: float, altitude_msl: float, omega_a: float,
     atmosphere: AtmosphereProfile | None = None,
 ) -> PlantPoint:  # fmt: skip
-    """GNC.md §5's plant at axial speed ``speed`` [m/s] and ``altitude_msl`` [m]: the coefficients of
+    """docs/gnc.md §5's plant at axial speed ``speed`` [m/s] and ``altitude_msl`` [m]: the coefficients of
     ``aero`` at that Mach number and altitude (in ``atmosphere``, the ISA if None), the moments moved from
     its reference to the CG of ``mass``, the force damping halved to PlantPoint's per ω·d/V."""
     air_there = air(atmosphere, altitude_msl)
@@ -266,7 +266,7 @@ def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
 
 
 STATE = ("v", "w", "p", "q", "r", "u_y", "u_p", "u_r", "e_p", "e_q", "e_r")
-"""The columns of K: the augmented state of GNC.md §5 (``gnc.design``); its rows are (yaw, pitch, roll)."""
+"""The columns of K: the augmented state of docs/gnc.md §5 (``gnc.design``); its rows are (yaw, pitch, roll)."""
 MAIN_GAINS = {"pitch": {"K_w": (1, 1), "K_q": (1, 3), "K_up": (1, 6), "K_eq": (1, 9)},
               "roll": {"K_p": (2, 2), "K_ur": (2, 7), "K_ep": (2, 8)}}  # fmt: skip
 """The gains that act in the pitch and roll channels, by (row, column) of K; the yaw row mirrors pitch."""

@@ -36,7 +36,7 @@ from .runner import ChunkResult, chunking
 
 MANIFEST = "manifest.json"
 MANIFEST_FORMAT = 2
-"""Version of the partial folder's layout: 2 since the set-up fingerprint (rocketmc 0.1, issue 15)."""
+"""Version of the partial folder's layout: 2 since the set-up fingerprint (rocketmc 0.1)."""
 CHUNK_FILE = re.compile(r"chunk_(\d{6})\.h5")
 GROUPS = ("outputs", "inputs")
 """The groups of a chunk file and of the result file."""

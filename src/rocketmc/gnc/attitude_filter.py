@@ -1,4 +1,4 @@
-"""Attitude and gyro-bias estimation: the thesis's multiplicative extended Kalman filter (GNC.md §2; Markley &
+"""Attitude and gyro-bias estimation: the thesis's multiplicative extended Kalman filter (docs/gnc.md §2; Markley &
 Crassidis 2014, ch. 6), one vehicle, pure JAX (jit, vmap and grad as they are; no branches on traced values).
 
 State: the attitude q̂ = q̂_nb (body FRD → NED) and the gyro bias β̂_b [rad/s]. Error state δx = [δϑ, Δβ]
@@ -14,7 +14,7 @@ with covariance P (6×6):
   Q11 = σ_v² T I + σ_u² (T³/3 I + 2 T⁵ S5 W²), Q12 = −σ_u² (T²/2 I − T³ S3 W + T⁴ S4 W²),
   Q22 = σ_u² T I,
   with S_m(x) = Σ_n (−x²)ⁿ/(2n + m)!: S1 = sin x/x, S2 = (1 − cos x)/x², S3 = (x − sin x)/x³,
-  S4 = (x²/2 + cos x − 1)/x⁴, 2 S5 = (x³/3 + 2 sin x − 2x)/x⁵ (GNC.md §2's expressions divided out). The
+  S4 = (x²/2 + cos x − 1)/x⁴, 2 S5 = (x³/3 + 2 sin x − 2x)/x⁵ (docs/gnc.md §2's expressions divided out). The
   closed forms cancel catastrophically at small x (the last two lose ~ε/x⁴), so below x = 1 the series
   (ten terms, truncation < 1e-17) are used: smooth in ω̂ down to 0, and ~1e-14 relative everywhere, where
   the thesis switched to first order below ‖ω̂‖ = 1e-5 rad/s. q̂⁻ = q̂⁺ ⊗ exp(ω̂T)
@@ -22,12 +22,12 @@ with covariance P (6×6):
 - magnetometer update, b and r normalised (b the measured field direction in body axes, r the
   reference in NED): h = A(q̂) r (A(q) = rotate_inverse: NED into body); b ≈ h + [h×] δϑ, so H = [[h×], 0];
   S = H P Hᵀ + σ_b² I, K = P Hᵀ S⁻¹, δx = K (b − h); Joseph form P⁺ = (I − KH) P (I − KH)ᵀ + σ_b² K Kᵀ
-  (symmetric and positive definite by construction); reset q̂⁺ = (q̂ ⊗ (1, δϑ/2))/‖·‖ (GNC.md's
+  (symmetric and positive definite by construction); reset q̂⁺ = (q̂ ⊗ (1, δϑ/2))/‖·‖ (docs/gnc.md's
   q⁻ + ½ Ξ(q⁻) δϑ, normalised), β̂⁺ = β̂ + Δβ. The radial part of b − h does nothing (K h = 0): a unit
   vector carries two directions of information. The rotation about the field line (fixed in NED) is never
   observed by the magnetometer alone; the rotation of the body makes the gyro bias observable.
 
-Unlike the thesis (GNC.md §2, its slips), the a-posteriori estimate is fed forward and output, and the
+Unlike the thesis (docs/gnc.md §2, its slips), the a-posteriori estimate is fed forward and output, and the
 update uses the Joseph form. The tuning knobs are the thesis's (σ_b = 2 on a unit vector: R = 4 I).
 
 Performance: this runs once per 20 ms control period inside a vmapped scan on CPU. 3×3 blocks are tuples
@@ -58,7 +58,7 @@ _SERIES = {m: [(-1.0) ** n / math.factorial(2 * n + m) for n in range(_SERIES_TE
 
 @pytree_dataclass
 class AttitudeTuning:
-    """The filter's noise model, the thesis's values (GNC.md §2) as defaults.
+    """The filter's noise model, the thesis's values (docs/gnc.md §2) as defaults.
 
     gyro_noise: σ_v, gyro white-noise density [rad/s/√s]; bias_walk: σ_u, gyro-bias random-walk density
     [rad/s²/√s]; field_direction_std: σ_b, per-axis std of the measured unit field direction [-] (R = σ_b² I);

@@ -1,4 +1,4 @@
-"""The closed loop's step at each control period (GNC.md §4-5): navigation → guidance → LQI → canard servos.
+"""The closed loop's step at each control period (docs/gnc.md §4-5): navigation → guidance → LQI → canard servos.
 
 At the start of each period t_k the controller reads the navigation solution, computes the body-rate command
 (``guidance.rate_command``), integrates the rate errors, interpolates the LQI gains designed on the host
@@ -28,7 +28,7 @@ from .navigation import DeadReckoning, FilterParams, FilterState, initial_dead_r
 from .guidance import GuidanceParams, Navigation, guidance_active, integrate_errors, rate_command
 
 GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
-"""Outputs of the gain table: K (3, 11) row by row; rows (yaw, pitch, roll), columns GNC.md §5's state
+"""Outputs of the gain table: K (3, 11) row by row; rows (yaw, pitch, roll), columns docs/gnc.md §5's state
 [v, w, p, q, r, u_y, u_p, u_r, e_p, e_q, e_r]."""
 
 

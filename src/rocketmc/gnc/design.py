@@ -1,4 +1,4 @@
-"""Host-side design of the LQI rate controller (GNC.md §5): the linear plant at one flight
+"""Host-side design of the LQI rate controller (docs/gnc.md §5): the linear plant at one flight
 condition, its discretisation, the discrete LQR gain of the augmented plant and a gain table over
 a grid of speed and altitude. numpy/scipy only, run once per campaign, never traced.
 
@@ -31,7 +31,7 @@ N_INPUT = 3  # virtual commands (yaw, pitch, roll)
 N_STATE = N_PLANT + N_INPUT  # with the integrators [e_p, e_q, e_r]
 RATE_INDEX = (2, 3, 4)  # p, q, r in the plant state, the rates the integrators follow
 
-# The weights the thesis flew (GNC.md §5), on the augmented state and the three inputs.
+# The weights the thesis flew (docs/gnc.md §5), on the augmented state and the three inputs.
 THESIS_Q = np.diag([0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0])
 THESIS_R = 100.0 * np.eye(N_INPUT)
 THESIS_DT = 0.02  # GNC period [s]
@@ -43,9 +43,9 @@ class FlownLoopUnstable(ValueError):
 
 
 class PlantPoint(NamedTuple):
-    """The rocket at one design point, as GNC.md §5's linear plant needs it.
+    """The rocket at one design point, as docs/gnc.md §5's linear plant needs it.
 
-    Coefficients per rad about the moment reference, the thesis's linear model (LYNX.md) and its
+    Coefficients per rad about the moment reference, the thesis's linear model (docs/lynx.md) and its
     conventions: β = v/u, α = w/u, δ the virtual deflection of the channel. Damping as the thesis
     writes it: the *force* damping cy_r, cn_q per ω·d/V (thesis 154; rocketmc's aero models use
     ω·d/(2V), i.e. twice that, 308), the *moment* damping cl_p, cm_q, cn_r per ω·d/(2V).
@@ -109,7 +109,7 @@ def density(altitude_msl: float) -> float:
 
 
 def lqi_plant(point: PlantPoint) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous plant ẋ = A x + B δ_cmd of GNC.md §5: A (8, 8), B (8, 3) in SI units (rad, m/s, rad/s).
+    """Continuous plant ẋ = A x + B δ_cmd of docs/gnc.md §5: A (8, 8), B (8, 3) in SI units (rad, m/s, rad/s).
 
     k_m = ρS/(2m), k_I = ρSd/(2Ixx), k_s = ρSd/(2Iyy); the lateral and rate equations are the
     rigid body's linearised about straight flight at axial speed u with zero rates.

@@ -1,8 +1,8 @@
-"""Guidance (GNC.md §4): the thesis's parabolic reference, the body-rate command that turns the velocity
-onto it, the roll command to a heading and the rate-error integrators the LQI follows (GNC.md §5).
+"""Guidance (docs/gnc.md §4): the thesis's parabolic reference, the body-rate command that turns the velocity
+onto it, the roll command to a heading and the rate-error integrators the LQI follows (docs/gnc.md §5).
 
 Pure JAX on scalar components (``Vec3``, ``Quat``), no branches on traced values: jit and vmap as they are.
-Frames: NED world from the pad, FRD body; ``q_nb`` rotates body vectors into NED, so GNC.md's
+Frames: NED world from the pad, FRD body; ``q_nb`` rotates body vectors into NED, so docs/gnc.md's
 A(q) (NED into body) is ``q_nb.rotate_inverse``. Time ``t`` is the time since liftoff [s] (liftoff = first
 motion on the rail): the reference and the window share that clock.
 """
@@ -34,7 +34,7 @@ class Navigation:
 
 @pytree_dataclass
 class GuidanceParams:
-    """Guidance parameters, the thesis's values (GNC.md §4) as defaults.
+    """Guidance parameters, the thesis's values (docs/gnc.md §4) as defaults.
 
     Reference parabola: apogee_m, the height H [m] the reference climbs after t0_s [s]; flight_path_angle_rad,
     γ0, the reference's flight-path angle at t0 (above the horizon) [rad]; heading_rad, ψ, its azimuth
@@ -68,7 +68,7 @@ def guidance_active(params: GuidanceParams, t) -> jnp.ndarray:
 def reference_direction(params: GuidanceParams, nav: Navigation, t) -> Vec3:
     """Desired velocity direction d_ref (unit, NED) of the parabolic reference at t [s since liftoff].
 
-    GNC.md §4: c1 = √(2 g0 H), v_x = c1/tan γ0, γ_ref = atan((c1 − g0 (t − t0))/v_x),
+    docs/gnc.md §4: c1 = √(2 g0 H), v_x = c1/tan γ0, γ_ref = atan((c1 − g0 (t − t0))/v_x),
     d_ref = (cos ψ cos γ_ref, sin ψ cos γ_ref, −sin γ_ref): a point mass climbing at c1 at t0 with horizontal
     speed v_x along ψ, which rises H after t0. The thesis's reference depends on time only, so ``nav`` is not
     read; it is in the signature so that a reference of the position can replace this one.
@@ -91,7 +91,7 @@ def _clip_norm2(y, z, limit):
 def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.ndarray]:
     """Body-rate command ω_cmd = (p, q, r), FRD [rad/s], and the tracking error χ [rad] at t [s since liftoff].
 
-    GNC.md §4, V = nav.v_n: χ = ∠(V, d_ref) ∈ [0, π], computed as atan2(‖V×d‖, V·d) (the thesis's
+    docs/gnc.md §4, V = nav.v_n: χ = ∠(V, d_ref) ∈ [0, π], computed as atan2(‖V×d‖, V·d) (the thesis's
     acos(V·d/‖V‖) loses digits near 0); n = V×d/‖V×d‖ (NED, 0 when V ∥ d), the axis about which a rotation by
     +χ turns V onto d (right-handed); ω_b = k χ A(q) n. Pitch and yaw: (q, r) = ω_b's y, z components, scaled
     together to a 2-norm of at most rate_limit, zero when ‖V‖ ≤ min_speed (ω_b's x component is dropped).
@@ -123,7 +123,7 @@ def integrate_errors(
 ) -> Vec3:
     """Rate-error integrators (e_p, e_q, e_r) [rad] one step dt [s] on: e += k_int (ω_cmd − ω) dt while active.
 
-    GNC.md §4's e_k = e_{k−1} + k_int T (ref − ω̂), with rates ω = (p, q, r) FRD [rad/s]. The sign is
+    docs/gnc.md §4's e_k = e_{k−1} + k_int T (ref − ω̂), with rates ω = (p, q, r) FRD [rad/s]. The sign is
     gnc/design.py's augmentation ė = −C x (C picks p, q, r) with the command added, ė = ω_cmd − ω, for which
     its gains u = −K x are designed; ``gain`` is k_int per axis (design.py assumes 1; the thesis flew
     ``GuidanceParams.integrator_gain``, 1, 12, 12). Not active: held bit for bit (the thesis resets them while

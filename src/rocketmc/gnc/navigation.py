@@ -5,7 +5,7 @@ Raw sensors: body rates from the gyroscope, the launch attitude propagated by th
 correction: its bias and noise integrate), position and velocity from the GNSS, held between fixes (zero
 before the first fix), liftoff from the accelerometer (both modes).
 
-Filters (GNC.md §2-3), at each GNC tick t_k: position and velocity propagated from t_{k-1} with the accelerometer's
+Filters (docs/gnc.md §2-3), at each GNC tick t_k: position and velocity propagated from t_{k-1} with the accelerometer's
 sample of t_{k-1} (the bus delivers it at t_k) rotated into NED by the attitude estimate of t_{k-1}, plus gravity;
 the attitude propagated with the gyroscope's rates of t_{k-1} less the estimated bias; then the magnetometer's
 update of the attitude, the GNSS's and the barometer's of position and velocity; the a-posteriori estimate is the

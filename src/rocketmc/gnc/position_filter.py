@@ -1,4 +1,4 @@
-"""The thesis's linear Kalman filter for position and velocity (GNC.md §3), NED from the pad, as three exact
+"""The thesis's linear Kalman filter for position and velocity (docs/gnc.md §3), NED from the pad, as three exact
 2-state filters.
 
 Model (period T [s]): x = [r_n, v_n], x⁻ = F x + G u, F = [I, T I; 0, I], G = [½T² I; T I], u the acceleration
@@ -35,7 +35,7 @@ from ..pytree import pytree_dataclass
 
 @pytree_dataclass
 class PositionTuning:
-    """The filter's noise model, the thesis's values (GNC.md §3) as defaults.
+    """The filter's noise model, the thesis's values (docs/gnc.md §3) as defaults.
 
     position_noise: σ_r, process-noise density on the position [m/√s] (Q_r = T σ_r²); velocity_noise: σ_v, on the
     velocity [m/s/√s] (Q_v = T σ_v²); gnss_position_std, gnss_velocity_std: GNSS measurement noise per axis N, E,
