@@ -22,11 +22,13 @@ GNC_SECTION = re.compile(r"gnc\.md §\s*([0-9]+)(?:\s*-\s*([0-9]+))?")
 
 
 def text_files(root: Path) -> list[Path]:
-    """The repository's text files under ``root``: the named folders' files by suffix (no caches), the root's."""
+    """The repository's text files under ``root``: the named folders' files by suffix (no caches, no egg-info that
+    the install writes), the root's."""
     files = [root / name for name in ROOT_FILES]
     for folder in FOLDERS:
         for path in sorted((root / folder).rglob("*")):
-            if path.is_file() and path.suffix in SUFFIXES and "__pycache__" not in path.parts:
+            built = any(part == "__pycache__" or part.endswith(".egg-info") for part in path.parts)  # install's
+            if path.is_file() and path.suffix in SUFFIXES and not built:
                 files.append(path)
     return files
 
