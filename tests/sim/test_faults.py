@@ -2,7 +2,7 @@
 
 The flight: lynx_ballistic_ctrl_1s (controller on from 1 s on perfect navigation, so that the sensors' faults do
 not change the flight) under a constant wind, nothing dispersed, with the thesis's sensors, the gyroscope and the
-accelerometer without errors but their bias (zero) so that a bias jump shows alone. Every fault at probability 1
+accelerometer without errors but their bias (zero) and the magnetometer truth-only, so that a step shows alone. Every fault at probability 1
 with fixed times and fins; the reference is the same flight with the canard faults only: the same truth, bit for
 bit, so the sensors' faults show as exact differences.
 """
