@@ -203,6 +203,28 @@ def navigation_warnings(run: Run) -> list[str]:
             "dispersion, not a working one's"]  # fmt: skip
 
 
+FAULT_FLAG = ".happened"
+"""The end of a fault's per-flight flag in ``/inputs``: ``faults.<fault>.happened``, 1 where the flight had it."""
+
+
+def fault_rows(run: Run) -> list[dict]:
+    """Per fault of the run (its ``/inputs/faults.<fault>.happened``): ``fault``, ``flights`` that had it, how many
+    of them are ``not_ok`` (a status code), and the 95 % ellipse of the ok impact points ``with`` every flight and
+    ``without`` the faulted ones (``Ellipse.to_dict()``; None below 3 points): what the fault costs."""
+    rows = []
+    for name in run.inputs.columns:
+        if not (name.startswith("faults.") and name.endswith(FAULT_FLAG)):
+            continue
+        faulted = run.inputs[name].to_numpy(dtype=float) > 0.5
+        ellipses = {}
+        for label, where in (("with", run.landed), ("without", run.landed & ~faulted)):
+            north, east = run.ok_impacts(where)
+            ellipses[label] = confidence_ellipse(north, east, 0.95).to_dict() if north.size >= 3 else None
+        rows.append({"fault": name.removeprefix("faults.").removesuffix(FAULT_FLAG), "flights": int(faulted.sum()),
+                     "not_ok": int((faulted & ~run.ok).sum()), **ellipses})  # fmt: skip
+    return rows
+
+
 def _stat(x: float) -> float | None:
     """Float, with NaN/inf mapped to None (strict JSON has no NaN)."""
     return float(x) if math.isfinite(x) else None
@@ -236,7 +258,8 @@ def summarize(run: Run) -> dict:
     at 50/95/99 % of the ok impact points; empty when fewer than 3 are available) and
     ``impact_ellipse_95_intervals`` (``bootstrap_intervals`` of the 95 % ellipse's area and centre;
     None below ``MIN_BOOTSTRAP_POINTS``) and ``navigation_diverged`` (flights of any status whose navigation
-    estimate diverged, ``Run.diverged``; None without navigation filters) and ``warnings`` (what ``run`` warned of:
+    estimate diverged, ``Run.diverged``; None without navigation filters) and ``faults`` (``fault_rows``: per fault
+    the flights that had it and the 95 % ellipse with and without them; empty without faults) and ``warnings`` (what ``run`` warned of:
     the nominal rocket's static stability, flights beyond the aerodynamic method's validity, the file's
     ``warnings`` attribute; then ``navigation_warnings``) and ``trajectories`` (the realizations whose trajectories
     the file keeps, ascending).
@@ -283,6 +306,7 @@ def summarize(run: Run) -> dict:
         "impact_ellipses": ellipses,
         "impact_ellipse_95_intervals": intervals,
         "navigation_diverged": int(run.diverged.sum()) if DIVERGED in run.outputs else None,
+        "faults": fault_rows(run),
         "warnings": json.loads(run.attrs.get("warnings", "[]")) + navigation_warnings(run),
         "trajectories": list(run.trajectories),
     }
@@ -380,4 +404,23 @@ def format_summary(summary: dict) -> str:
                    f"E {i['center_east_m'][0]:.1f}…{i['center_east_m'][1]:.1f} m")  # fmt: skip
     else:
         out.append("  not available: fewer than 3 ok impact points")
+    if summary["faults"]:
+        out += ["", "Faults (/inputs/faults.*): the 95 % ellipse of the ok flights with and without the faulted ones"]
+        out += _table(["fault", "flights", "not ok", "area with [km^2]", "without [km^2]", "change", "centre with N, E [m]",
+                       "without N, E [m]"], [_fault_cells(f) for f in summary["faults"]], align="lrrrrrrr")  # fmt: skip
     return "\n".join(out)
+
+
+def _fault_cells(row: dict) -> list[str]:
+    """A ``fault_rows`` row as text: the ellipses' areas, the change from without to with, their centres."""
+    with_, without = row["with"], row["without"]
+
+    def area(e):
+        return "-" if e is None else f"{e['area_m2'] / 1e6:.4g}"
+
+    def centre(e):
+        return "-" if e is None else f"{e['center_north_m']:.1f}, {e['center_east_m']:.1f}"
+
+    change = "-" if with_ is None or without is None else f"{100 * (with_['area_m2'] / without['area_m2'] - 1):+.1f} %"
+    return [row["fault"], str(row["flights"]), str(row["not_ok"]), area(with_), area(without), change, centre(with_),
+            centre(without)]

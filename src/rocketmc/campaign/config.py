@@ -959,6 +959,109 @@ class AvionicsConfig(_Strict):
         return name
 
 
+MAX_SLOW_FACTOR = 100.0  # a servo 100× slower than Lynx's (0.077 s → 7.7 s) no longer moves in the window: stuck
+MAX_FIELD_STEP_UT = 10_000.0  # 200 × the geomagnetic field: a motor's current (~100 A at ~10 cm) makes ~200 µT
+FaultTime = Annotated[float, Field(ge=0, le=MAX_FLIGHT_TIME_S)]
+
+
+class _Fault(_Strict):
+    """A fault that a flight has with ``probability``, drawn per flight from its own random stream."""
+
+    probability: float = Field(ge=0, le=1, description="chance that a flight has it (0: off, nothing drawn or flown)")
+
+    @staticmethod
+    def _window(window: list[float]) -> list[float]:
+        if not window[0] <= window[1]:
+            raise ValueError(f"must be [earliest, latest] with earliest ≤ latest, got {window}")
+        return window
+
+
+TimeWindow = Annotated[list[FaultTime], Field(min_length=2, max_length=2)]
+
+
+class _TimedFault(_Fault):
+    """A fault from a time drawn uniformly in ``time_s`` = [earliest, latest] [s from t = 0, on the pad] (equal: fixed)."""
+
+    time_s: TimeWindow = Field(description="[earliest, latest] time of the fault, drawn uniformly [s from t = 0]")
+
+    @field_validator("time_s")
+    @classmethod
+    def _ordered(cls, window: list[float]) -> list[float]:
+        return cls._window(window)
+
+
+class _CanardFault(_TimedFault):
+    """A fault of one canard servo: fin δ1..δ4 (none: drawn uniformly per flight)."""
+
+    fin: int | None = Field(None, ge=1, le=4, description="the faulty fin, 1..4 (none: drawn per flight)")
+
+
+class StuckCanardConfig(_CanardFault):
+    """A canard servo that stops moving at the fault time: frozen at its deflection then, or at ``angle_deg``."""
+
+    angle_deg: float | None = Field(None, ge=-MAX_CANARD_LIMIT_DEG, le=MAX_CANARD_LIMIT_DEG,
+                                    description="the deflection it is stuck at (none: where it was at the fault) [deg]")
+
+
+class SlowCanardConfig(_CanardFault):
+    """A canard servo whose time constant is multiplied by ``factor`` from the fault time."""
+
+    factor: float = Field(ge=1, le=MAX_SLOW_FACTOR, description="its time constant's multiplier [-]")
+
+
+class GnssOutageConfig(_Fault):
+    """No GNSS fix from a start drawn in ``start_s`` for a duration drawn in ``duration_s`` (uniform)."""
+
+    start_s: TimeWindow = Field(description="[earliest, latest] start of the outage [s from t = 0]")
+    duration_s: TimeWindow = Field(description="[shortest, longest] duration of the outage [s]")
+
+    @field_validator("start_s", "duration_s")
+    @classmethod
+    def _ordered(cls, window: list[float]) -> list[float]:
+        return cls._window(window)
+
+
+class MagnetometerStepConfig(_TimedFault):
+    """A body-fixed magnetic field of ``magnitude_ut`` in a direction drawn uniformly from the fault time on (the
+    motor's or an ignition current's signature), seen by the magnetometer as a hard-iron step."""
+
+    magnitude_ut: float = Field(gt=0, le=MAX_FIELD_STEP_UT, description="the field step's magnitude [µT]")
+
+
+class GyroscopeBiasJumpConfig(_TimedFault):
+    """The gyroscope's bias jumps by ``magnitude_deg_s`` in a direction drawn uniformly (sensor frame)."""
+
+    magnitude_deg_s: float = Field(gt=0, le=MAX_RATE_DEG_S, description="the jump's magnitude [deg/s]")
+
+
+class AccelerometerBiasJumpConfig(_TimedFault):
+    """The accelerometer's bias jumps by ``magnitude_mps2`` in a direction drawn uniformly (sensor frame)."""
+
+    magnitude_mps2: float = Field(gt=0, le=MAX_SENSOR_VALUE, description="the jump's magnitude [m/s²]")
+
+
+class FaultsConfig(_Strict):
+    """Faults a campaign disperses (docs/faults.md), each absent (none) or with its probability per flight."""
+
+    stuck_canard: StuckCanardConfig | None = None
+    slow_canard: SlowCanardConfig | None = None
+    gnss_outage: GnssOutageConfig | None = None
+    magnetometer_step: MagnetometerStepConfig | None = None
+    gyroscope_bias_jump: GyroscopeBiasJumpConfig | None = None
+    accelerometer_bias_jump: AccelerometerBiasJumpConfig | None = None
+
+    def active(self) -> dict[str, _Fault]:
+        """The faults some flight can have (given, probability above 0), by name in the table's order."""
+        return {name: f for name in type(self).model_fields if (f := getattr(self, name)) is not None
+                and f.probability > 0.0}  # fmt: skip
+
+
+FAULT_SECTIONS = {"stuck_canard": "gnc", "slow_canard": "gnc", "gnss_outage": "avionics",
+                  "magnetometer_step": "avionics", "gyroscope_bias_jump": "avionics",
+                  "accelerometer_bias_jump": "avionics"}  # fmt: skip
+"""The section each fault acts on: the canard servos of [gnc], the sensors of [avionics]."""
+
+
 class CampaignConfig(_Strict):
     name: str = Field(description=f"a label of 1 to {MAX_NAME_LENGTH} printable characters on one line")
     description: str = Field("", description="free text")
@@ -972,6 +1075,7 @@ class CampaignConfig(_Strict):
     simulation: SimulationConfig = SimulationConfig()
     gnc: GncConfig | None = Field(None, description="the closed loop; None: no controller, canards neutral")
     avionics: AvionicsConfig | None = Field(None, description="the sensors; None: no sensors simulated")
+    faults: FaultsConfig | None = Field(None, description="faults drawn per flight (docs/faults.md); None: none")
 
     @field_validator("name")
     @classmethod
@@ -1012,10 +1116,10 @@ class Campaign:
     ) -> Campaign:  # fmt: skip
         """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
         True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
-        (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
+        and its faults (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
         (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
         campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
-        perfect navigation; navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
+        perfect navigation (their faults removed too); navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
         values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above, and
         dispersions by their parameter's path after ``dispersions.``: a table sets one, None removes it."""
         if navigation is not None:
@@ -1031,6 +1135,8 @@ class Campaign:
             if on is not None and on != (data[section] is not None):
                 data[section] = {} if on else None
                 data["dispersions"] = {k: d for k, d in data["dispersions"].items() if on or not k.startswith(section + ".")}
+                if not on and data["faults"] is not None:  # its faults go with it
+                    data["faults"].update({name: None for name, s in FAULT_SECTIONS.items() if s == section})
         if sensors is not None and data["gnc"] is not None:
             current = data["gnc"].get("navigation", "truth")  # a [gnc] just added is empty: the schema's default
             kept = current if current != "truth" else "sensors"
@@ -1345,10 +1451,24 @@ def _check_pad_samples(config: CampaignConfig) -> None:
                           "gnc.filters.pad_samples, or initialise from the 'rail')")  # fmt: skip
 
 
+def _check_faults(config: CampaignConfig) -> None:
+    """Each fault some flight can have acts on a section the campaign has (the servos of [gnc], the sensors of
+    [avionics]), and a bias jump on a sensor with errors (a truth-only sensor has no bias)."""
+    for name in ({} if config.faults is None else config.faults.active()):
+        section = FAULT_SECTIONS[name]
+        if getattr(config, section) is None:
+            acts_on = "the canard servos" if section == "gnc" else "the sensors"
+            raise ConfigError(f"faults.{name}: needs a [{section}] section ({acts_on} it acts on)")
+        sensor = name.removesuffix("_bias_jump")
+        if sensor != name and getattr(config.avionics, sensor).truth_only:
+            raise ConfigError(f"faults.{name}: avionics.{sensor} is truth_only (no errors, so no bias to jump)")
+
+
 def _with_sensor_spreads(config: CampaignConfig) -> CampaignConfig:
-    """``config`` checked (``_check_avionics``) with its sensors' spreads among its dispersions, the file's own
-    dispersions kept where both name a value."""
+    """``config`` checked (``_check_avionics``, ``_check_faults``) with its sensors' spreads among its dispersions,
+    the file's own dispersions kept where both name a value."""
     _check_avionics(config)
+    _check_faults(config)
     return config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
 
 

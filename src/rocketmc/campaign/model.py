@@ -33,10 +33,11 @@ from ..env.magnetic import igrf_site_field_gradient, site_field_gradient, site_f
 from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
+from ..sim.faults import Faults, GnssOutage, SensorStep, SlowCanard, StuckCanard
 from ..sim.flight import rail_start_n
 from ..sim.params import Environment, FlightParams, Launch, Rocket
 from .config import Campaign, FiltersConfig, sample_period_ticks, sensor_ticks
-from .sampling import realization_key, stream_key
+from .sampling import UNIT_FIELDS, realization_key, stream_key
 
 
 def _vector(values: Mapping, path: str, n: int, suffix: str = ""):
@@ -142,7 +143,48 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
         turbulence=_turbulence(campaign, v, key),
         atmosphere=_atmosphere(campaign),
     )
-    return FlightParams(rocket, launch, environment, _gnc(campaign, v), _avionics(campaign, v, key, body_x, aero.n_canards))
+    avionics = _avionics(campaign, v, key, body_x, aero.n_canards)
+    return FlightParams(rocket, launch, environment, _gnc(campaign, v), avionics, _faults(campaign, v, avionics))
+
+
+def _faults(campaign: Campaign, v: Mapping, avionics: Avionics | None) -> Faults | None:
+    """The faults the campaign can fly (``FaultsConfig.active``) from their draws in ``v`` (``sample_faults``), in SI
+    and the sensors' frames (the magnetometer's step through its mounting); None without any, or without their draws
+    (the nominal flight)."""
+    faults = campaign.config.faults
+    active = {} if faults is None else faults.active()
+    if not active or f"faults.{next(iter(active))}.happened" not in v:
+        return None
+
+    def at(name: str, what: str = "time_s"):  # the fault's time [s], inf where it did not happen
+        return jnp.where(v[f"faults.{name}.happened"] > 0.5, v[f"faults.{name}.{what}"], jnp.inf)
+
+    def fin(name: str):  # (4,) bool, the faulty fin (none where it did not happen: NaN)
+        return jnp.arange(1.0, 5.0) == v[f"faults.{name}.fin"]
+
+    def vector(name: str, unit: float):  # the drawn vector in SI, zeros where it did not happen
+        path = f"faults.{name}.{UNIT_FIELDS[name][1]}"
+        return jnp.where(v[f"faults.{name}.happened"] > 0.5, _vector(v, path, 3) * unit, 0.0)
+
+    built = {}
+    if "stuck_canard" in active:
+        angle = active["stuck_canard"].angle_deg
+        built["stuck_canard"] = StuckCanard(at("stuck_canard"), fin("stuck_canard"),
+                                            None if angle is None else jnp.asarray(math.radians(angle)))  # fmt: skip
+    if "slow_canard" in active:
+        built["slow_canard"] = SlowCanard(at("slow_canard"), fin("slow_canard"),
+                                          jnp.asarray(active["slow_canard"].factor))  # fmt: skip
+    if "gnss_outage" in active:
+        built["gnss_outage"] = GnssOutage(at("gnss_outage", "start_s"), at("gnss_outage", "end_s"))
+    if "magnetometer_step" in active:
+        step_b = vector("magnetometer_step", SENSOR_UNITS["magnetometer"])
+        rotation = avionics.magnetometer.sensor.rotation  # body → sensor
+        step_s = jnp.stack([sum(rotation[i, j] * step_b[j] for j in range(3)) for i in range(3)])
+        built["magnetometer_step"] = SensorStep(at("magnetometer_step"), step_s)
+    for sensor in ("gyroscope", "accelerometer"):
+        if (name := f"{sensor}_bias_jump") in active:
+            built[name] = SensorStep(at(name), vector(name, SENSOR_UNITS[sensor]))
+    return Faults(**built)
 
 
 def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:

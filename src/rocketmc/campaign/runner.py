@@ -29,7 +29,7 @@ from ..sim.params import SimSettings
 from .config import Campaign
 from .fingerprint import fingerprint, setup
 from .model import flight_params
-from .sampling import realization_key, sample_dispersions
+from .sampling import realization_key, sample_dispersions, sample_faults
 
 
 def sim_settings(campaign: Campaign) -> SimSettings:
@@ -43,7 +43,7 @@ def sim_settings(campaign: Campaign) -> SimSettings:
 def realization_params(campaign: Campaign, master_key, index):
     """Realization ``index``'s (flight parameters, drawn inputs)."""
     key = realization_key(master_key, index)
-    drawn = sample_dispersions(campaign, key)
+    drawn = {**sample_dispersions(campaign, key), **sample_faults(campaign.config.faults, key)}
     return flight_params(campaign, {**campaign.nominal, **drawn}, key), drawn
 
 

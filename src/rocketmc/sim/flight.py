@@ -34,6 +34,7 @@ from ..sensors.avionics import (
     AvionicsState, avionics_noise, gyroscope_bias_b, initial_avionics, sense, sense_acceleration, specific_force_b,
 )  # fmt: skip
 from ..pytree import pytree_dataclass, tree_where
+from .faults import faulty_servos, faulty_sensors
 from .params import FlightParams, SimSettings
 
 OUTSIDE_TABLES_QBAR_FRACTION = 0.1
@@ -483,9 +484,12 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     gnc = gnc_step(p.gnc, state.gnc, nav, moving, t0, settings.control_dt_s, altitude_msl, canopy, feedback)
     if p.gnc.navigation == "filters":
         gnc = dataclasses.replace(gnc, navigation=_tracked(p, settings, state, gnc, canopy))
-    servo = end_of_period(servo_params, gnc.servo, period)
+    held = gnc.servo
+    if p.faults is not None and p.faults.servos:
+        servo_params, held = faulty_servos(p.faults, servo_params, held, t0)
+    servo = end_of_period(servo_params, held, period)
     state, first = control_step(p, settings, start_n, state, period,
-                                lambda t: deflection_at(servo_params, gnc.servo, t - t0), noise.turbulence,
+                                lambda t: deflection_at(servo_params, held, t - t0), noise.turbulence,
                                 p.avionics is not None)  # fmt: skip
     state = dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
     return _accelerometer(p, start, state, first, sensing, noise)
@@ -498,9 +502,15 @@ def _tracked(p: FlightParams, settings: SimSettings, state: FlightState, gnc: Gn
     body, events, dt = state.body, state.events, settings.control_dt_s
     window = guidance_active(p.gnc.guidance, state.t - gnc.liftoff_time) & ~canopy
     ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
-    return track_errors(gnc.navigation, body.q_nb, body.r_n, body.v_n, gyroscope_bias_b(p.avionics, state.avionics),
+    return track_errors(gnc.navigation, body.q_nb, body.r_n, body.v_n,
+                        gyroscope_bias_b(_avionics_at(p, state.t), state.avionics),
                         jnp.where(window, dt, 0.0), jnp.where(ascent, dt, 0.0), state.t >= events.burnout_time,
                         state.t >= events.apogee_time)  # fmt: skip
+
+
+def _avionics_at(p: FlightParams, t):
+    """The sensors as they sample at ``t`` [s]: with the faults that happened by then (``sim.faults``)."""
+    return faulty_sensors(p.faults, p.avionics, t) if p.faults is not None and p.faults.sensors else p.avionics
 
 
 def _at_rest_once_landed(state: FlightState) -> RigidBodyState:
@@ -515,7 +525,7 @@ def _sensed(p: FlightParams, state: FlightState, deflections, sensing, noise: St
     if p.avionics is None:
         return state
     body = _at_rest_once_landed(state)
-    avionics = sense(p.avionics, state.avionics, state.tick, state.t, body.r_n, body.v_n, body.q_nb, body.omega_b,
+    avionics = sense(_avionics_at(p, state.t), state.avionics, state.tick, state.t, body.r_n, body.v_n, body.q_nb, body.omega_b,
                      deflections, p.environment, sensing, noise.avionics)  # fmt: skip
     return dataclasses.replace(state, avionics=avionics)
 
@@ -535,7 +545,8 @@ def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, firs
     force = specific_force_b(tree_where(landed, zero, acceleration_n), body.q_nb, body.omega_b,
                              tree_where(landed, zero, omega_dot_b), arm_b)  # fmt: skip
     qbar = jnp.where(landed, 0.0, qbar)
-    avionics = sense_acceleration(p.avionics, state.avionics, start.tick, force, qbar, sensing, noise.avionics)
+    avionics = sense_acceleration(_avionics_at(p, start.t), state.avionics, start.tick, force, qbar, sensing,
+                                  noise.avionics)  # fmt: skip
     return dataclasses.replace(state, avionics=avionics)
 
 

@@ -14,6 +14,7 @@ from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
 from ..env.atmosphere import AtmosphereProfile, AtmosphereState, air
 from ..math import Quat, Vec3
 from ..pytree import pytree_dataclass
+from .faults import Faults
 
 
 @pytree_dataclass
@@ -76,13 +77,15 @@ class Environment:
 @pytree_dataclass
 class FlightParams:
     """Everything one realization needs (all leaves dynamic: they can be dispersed); gnc: the closed
-    loop (None: canards neutral, and no cost); avionics: the sensors (None: none simulated, and no cost)."""
+    loop (None: canards neutral, and no cost); avionics: the sensors (None: none simulated, and no cost); faults:
+    the servos' and sensors' faults (``sim.faults``; None: none, and no cost)."""
 
     rocket: Rocket
     launch: Launch
     environment: Environment
     gnc: GncParams | None = None
     avionics: Avionics | None = None
+    faults: Faults | None = None
 
 
 @dataclasses.dataclass(frozen=True)
