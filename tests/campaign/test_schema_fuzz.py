@@ -368,6 +368,8 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "gnss_velocity_std_mps = [50.0, -50.0, 70.0]", "gnc.filters.position.gnss_velocity_std_mps.1"),
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
          '[gnc.filters]\ninitialisation = "pad"', "gnc.filters.initialisation"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
+         '[gnc.filters]\ninitialisation = "level"', "gnc.filters.initialisation"),
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[gnc]\nnavigation = "filters"', "gnc.navigation"),
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
@@ -377,7 +379,7 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "unknown-part", "part-without-the-sensor", "negative-noise-density", "rate-not-dividing-the-gnc-rate",
          "range-without-zero", "latency-between-ticks", "sensor-navigation-without-avionics", "sensor-rate-dispersed",
          "filter-covariance-zero", "filter-covariance-negative", "pad-initialisation-without-pad-time",
-         "filters-without-avionics"],
+         "level-initialisation-without-pad-time", "filters-without-avionics"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old
@@ -482,7 +484,7 @@ def test_gnc_base_is_valid():
          "gnc.filters.position.altitude_gate: Input should be greater than 0 (got -9.0)"),
         ("gnc.filters.attitude.field_gate", 1e5, "gnc.filters.attitude.field_gate: Input should be less than or equal to"),
         ("gnc.filters.position.gnss_gate", "tight", "gnc.filters.position.gnss_gate: Input should be a valid number"),
-        ("gnc.filters.initialisation", "triad", "gnc.filters.initialisation: Input should be 'rail' or 'pad'"),
+        ("gnc.filters.initialisation", "triad", "gnc.filters.initialisation: Input should be 'rail', 'pad' or 'level'"),
     ],
 )  # fmt: skip
 def test_bad_gnc_fields_are_refused_naming_the_field(path, value, message_start):

@@ -30,6 +30,7 @@ from rocketmc.gnc.attitude_filter import (
     magnetometer_update,
     propagate_attitude,
     rotation_step,
+    level,
     triad,
 )
 from rocketmc.math.vectors import Quat, Vec3
@@ -269,6 +270,48 @@ def test_triad_trusts_gravity_over_the_field():
     q = triad(vec(force_b), vec(field_b), FIELD_N)
     np.testing.assert_allclose(dcm(q) @ force_b / 9.80665, [0.0, 0.0, -1.0], rtol=0, atol=1e-15)
     assert Rotation.from_matrix(dcm(q)).inv().__mul__(rotation).magnitude() < 0.1
+
+
+# --- levelling ----------------------------------------------------------------------------------------------
+
+
+def rail(elevation_deg, azimuth_deg, roll_deg) -> Rotation:
+    """A rocket on a rail: yaw (the azimuth), pitch (the elevation), roll, 3-2-1."""
+    return Rotation.from_euler("ZYX", np.stack([azimuth_deg, elevation_deg, roll_deg], axis=-1), degrees=True)
+
+
+def rotation(q: Quat) -> Rotation:
+    return Rotation.from_quat(np.stack([q.x, q.y, q.z, q.w], axis=-1))
+
+
+def test_level_takes_the_elevation_from_the_accelerometer_and_keeps_the_azimuth_and_roll():
+    """A rail whose elevation is off the nominal's (any azimuth and roll): levelling the nominal attitude with the
+    specific force at rest on the true rail gives the true attitude, its elevation the accelerometer's and its
+    azimuth and roll the nominal's, which are the true ones (roundoff of a few products)."""
+    rng = np.random.default_rng(3)
+    azimuth, roll = rng.uniform(0.0, 360.0, 64), rng.uniform(-180.0, 180.0, 64)
+    elevation = rng.uniform(60.0, 89.5, 64)
+    nominal, true = rail(elevation, azimuth, roll), rail(elevation + rng.normal(0.0, 1.0, 64), azimuth, roll)
+    force_b = true.inv().apply([0.0, 0.0, -9.80665])
+    x, y, z, w = nominal.as_quat().T
+    levelled = jax.vmap(level)(Quat(w, x, y, z), Vec3.from_array(force_b))
+    assert (rotation(levelled) * true.inv()).magnitude().max() < 1e-14
+    same = jax.vmap(level)(Quat(w, x, y, z), Vec3.from_array(nominal.inv().apply([0.0, 0.0, -1.0])))
+    assert (rotation(same) * nominal.inv()).magnitude().max() < 1e-14
+
+
+def test_level_points_the_measured_up_up_and_does_not_roll():
+    """The nominal rail (84° toward 131°) levelled by the specific force on a rail at 84.6° toward 130°, the
+    rocket rolled by 3° on it, plus an accelerometer bias: the measured up is up exactly (the x axis's elevation the
+    accelerometer's), and the correction is a tilt, not a roll: the least rotation's axis is perpendicular to the
+    two up directions, which are ~6° off the x axis, so its component about x is ≤ sin(6°) of its 0.50° (measured
+    0.011°). The 3° roll the accelerometer sees only through its 1 m/s² across the axis is left to the rail's."""
+    nominal, true = rail(84.0, 131.0, 0.0), rail(84.6, 130.0, 3.0)
+    force_b = true.inv().apply([0.0, 0.0, -9.80665]) + np.array([0.0, 0.03, -0.02])
+    levelled = Rotation.from_matrix(dcm(level(quat(nominal), vec(force_b))))
+    np.testing.assert_allclose(levelled.apply(force_b) / np.linalg.norm(force_b), [0.0, 0.0, -1.0], rtol=0, atol=1e-15)
+    turn_b = (nominal.inv() * levelled).as_rotvec(degrees=True)
+    assert 0.4 < np.linalg.norm(turn_b) < 0.6 and abs(turn_b[0]) < np.sin(np.radians(6.0)) * np.linalg.norm(turn_b)
 
 
 # --- consistency ----------------------------------------------------------------------------------------------

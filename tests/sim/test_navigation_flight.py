@@ -42,9 +42,10 @@ for its roll about the field line."""
 
 
 def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: dict | None = None,
-             sensors: dict | None = None):
+             sensors: dict | None = None, initialisation: str = "pad"):
     """lynx_ballistic_gnc_1s under a constant 10 m/s wind from the launch azimuth, nothing dispersed; errors False:
-    every sensor truth-only; pad_samples: TRIAD from that many pad ticks, the motor lit 0.2 s after them;
+    every sensor truth-only; pad_samples: the filters initialised from that many pad ticks (``initialisation``),
+    the motor lit 0.2 s after them;
     magnetometer: fields of its [avionics.magnetometer] table; sensors: [avionics] tables of fields over the thesis
     part's."""
     path = CAMPAIGNS / "lynx_ballistic_gnc_1s.toml"
@@ -59,7 +60,7 @@ def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: 
         raw["avionics"]["magnetometer"] = magnetometer
     raw["avionics"].update(sensors or {})
     if pad_samples is not None:
-        raw["gnc"]["filters"] = {"initialisation": "pad", "pad_samples": pad_samples}
+        raw["gnc"]["filters"] = {"initialisation": initialisation, "pad_samples": pad_samples}
         raw["rocket"].setdefault("motor", {})["ignition_delay_s"] = pad_samples * 0.02 + 0.2
     return campaign_from_dict(raw, path.parent)
 
@@ -162,20 +163,26 @@ PAD_TICKS = 250
 """Pad samples of the TRIAD test: 5 s at 50 Hz, the thesis gyro's 0.3 deg/s noise averaged to 0.019 deg/s."""
 
 
-def test_pad_samples_initialise_the_attitude_by_triad_and_the_gyro_bias():
-    """PAD_TICKS pad ticks, the motor lit 0.2 s later: TRIAD on the mean accelerometer and magnetometer
-    directions replaces the rail's attitude at the last of them, with the initial covariance, and the gyroscope's
-    mean rate its bias. The thesis's sensors' accelerometer bias (≤ 0.04 m/s² against g: 0.2°), the averaged noise
-    and the magnetometer's 0.3° misalignment bound the attitude's error to ~0.5°; 1.5° leaves room, and a frame or
-    sign slip in TRIAD is tens of degrees off. The gyroscope's bias walk off (the mean then estimates a constant),
+@pytest.mark.parametrize("initialisation", ["pad", "level"])
+def test_pad_samples_initialise_the_attitude_and_the_gyro_bias(initialisation):
+    """PAD_TICKS pad ticks, the motor lit 0.2 s later: at the last of them the attitude is set with the initial
+    covariance, by TRIAD on the mean accelerometer and magnetometer directions ("pad") or as the rail's, held
+    until then, levelled by the mean accelerometer direction ("level"), and the gyroscope's mean rate sets its bias.
+    The thesis's sensors' accelerometer bias (≤ 0.04 m/s² against g: 0.2°), the averaged noise and the
+    magnetometer's 0.3° misalignment bound the attitude's error to ~0.5°; 1.5° leaves room, and a frame or
+    sign slip is tens of degrees off. The gyroscope's bias walk off (the mean then estimates a constant),
     each axis of the bias estimate is within 4 σ/√n of the drawn bias (σ the gyro's 0.3 deg/s per sample, n the
     PAD_TICKS samples at rest; 4 σ: a chance of 6e-5 per axis to fail by noise; its 0.015 deg/s LSB is dithered by
     that noise); the rail's initialisation has a zero bias, 0.1 to 0.25 deg/s off."""
-    campaign = headwind(pad_samples=PAD_TICKS, sensors={"gyroscope": {"bias_walk": 0.0}})
+    campaign = headwind(pad_samples=PAD_TICKS, sensors={"gyroscope": {"bias_walk": 0.0}}, initialisation=initialisation)
     p, traj, (_, status) = flown(campaign)
     assert int(status) == Status.MAX_TIME  # flown 20 s, not to the ground: nothing else failed
     variance = np.asarray(traj.gnc.navigation.attitude.cov[:, 0, 0])
     reset = np.flatnonzero(variance == float(p.gnc.filters.attitude.initial_attitude_std) ** 2)
+    if initialisation == "level":  # the rail's attitude and covariance held from t = 0 to the reset
+        q_nb = np.asarray(traj.gnc.navigation.attitude.q_nb.to_array())
+        np.testing.assert_array_equal(q_nb[: PAD_TICKS - 1], np.broadcast_to(p.gnc.rail_q_nb.to_array(), (PAD_TICKS - 1, 4)))
+        reset = reset[reset >= PAD_TICKS - 1]
     assert len(reset) == 1 and reset[0] == PAD_TICKS - 1  # the period whose start is the last tick on the pad
     assert attitude_errors_deg(traj)[1][reset[0] - 1] < 1.5  # the solution at that tick against the truth then
     assert float(traj.gnc.liftoff_time[-1]) > PAD_TICKS * 0.02  # liftoff sensed after the pad samples

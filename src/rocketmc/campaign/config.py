@@ -711,15 +711,18 @@ class PositionFilterConfig(_Strict):
 
 
 class FiltersConfig(_Strict):
-    """The navigation filters of ``navigation = "filters"``: initialised from the launch rail's nominal elevation and
-    azimuth ("rail") or from the mean of ``pad_samples`` accelerometer and magnetometer samples on the pad (TRIAD)
-    and the gyroscope's mean rate there as its bias ("pad": the motor must light after them,
-    ``rocket.motor.ignition_delay_s``); their tunings."""
+    """The navigation filters of ``navigation = "filters"``: initialised from the launch rail's nominal elevation,
+    azimuth and the rocket's roll on it, the gyro bias zero ("rail"); from the mean of ``pad_samples`` accelerometer
+    and magnetometer samples on the pad (TRIAD) and the gyroscope's mean rate there as its bias ("pad"); or from the
+    nominal rail's attitude levelled by the accelerometer's pad mean (its tilt measured, its azimuth and roll the
+    rail's) and the gyroscope's pad mean as its bias ("level"). "pad" and "level" need the motor to light after the
+    pad samples (``rocket.motor.ignition_delay_s``). Their tunings."""
 
-    initialisation: Literal["rail", "pad"] = Field(
-        "rail", description="the nominal rail's attitude, or TRIAD and the gyro's mean (its bias) on the pad")
-    pad_samples: int = Field(500, ge=1, le=100_000,
-                             description="GNC ticks on the pad averaged for TRIAD and the gyro bias (\"pad\")")
+    initialisation: Literal["rail", "pad", "level"] = Field(
+        "rail", description="the nominal rail's attitude; TRIAD and the gyro's mean (its bias) on the pad; or the "
+                            "nominal rail's levelled by the pad's accelerometer, and the gyro's pad mean")  # fmt: skip
+    pad_samples: int = Field(500, ge=1, le=100_000, description="GNC ticks on the pad averaged for TRIAD and the "
+                                                                 "gyro bias (\"pad\", \"level\")")  # fmt: skip
     attitude: AttitudeFilterConfig = AttitudeFilterConfig()
     position: PositionFilterConfig = PositionFilterConfig()
 
@@ -1431,7 +1434,7 @@ def _check_avionics(config: CampaignConfig) -> None:
     gnc = config.gnc
     if gnc is not None and gnc.navigation != "truth" and config.avionics is None:
         raise ConfigError(f"gnc.navigation: '{gnc.navigation}' needs an [avionics] section (the sensors it reads)")
-    if gnc is not None and gnc.navigation == "filters" and gnc.filters.initialisation == "pad":
+    if gnc is not None and gnc.navigation == "filters" and gnc.filters.initialisation != "rail":
         _check_pad_samples(config)
     for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
         sample_period_ticks(config, sensor)
@@ -1446,7 +1449,8 @@ def _check_pad_samples(config: CampaignConfig) -> None:
     nominal, d = config.rocket.motor.ignition_delay_s, config.dispersions.get(path)
     earliest = min([nominal] + ([] if d is None else [value for value, _ in _drawable_values(d, nominal, path)]))
     if earliest < pad:
-        raise ConfigError(f"gnc.filters.initialisation: 'pad' needs {config.gnc.filters.pad_samples} samples on the "
+        raise ConfigError(f"gnc.filters.initialisation: '{config.gnc.filters.initialisation}' needs "
+                          f"{config.gnc.filters.pad_samples} samples on the "
                           f"pad ({pad:g} s) before ignition, but {path} can be {earliest:g} s (raise it, lower "
                           "gnc.filters.pad_samples, or initialise from the 'rail')")  # fmt: skip
 

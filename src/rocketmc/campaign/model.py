@@ -251,8 +251,8 @@ def filter_params(campaign: Campaign) -> FilterParams:
         field_t, gradient = (site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m)
                              if model == "dipole" else _igrf(config))  # fmt: skip
     return FilterParams(attitude, position, jnp.asarray(field_t), jnp.asarray(gradient), jnp.asarray(p.gnss_after_s),
-                        f.pad_samples if f.initialisation == "pad" else 0, p.gnss == "horizontal", p.barometer,
-                        a.field_gate, p.gnss_gate, p.altitude_gate)  # fmt: skip
+                        0 if f.initialisation == "rail" else f.pad_samples, f.initialisation == "pad",
+                        p.gnss == "horizontal", p.barometer, a.field_gate, p.gnss_gate, p.altitude_gate)  # fmt: skip
 
 
 SENSOR_UNITS = {"accelerometer": 1.0, "gyroscope": math.pi / 180.0, "magnetometer": 1e-6, "barometer": 1.0,

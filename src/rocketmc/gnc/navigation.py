@@ -26,7 +26,7 @@ from ..pytree import pytree_dataclass, static_field, tree_where
 from ..sensors.avionics import Avionics, Bus, to_body
 from .attitude_filter import (
     AttitudeEstimate, AttitudeTuning, attitude_error_b, attitude_nees, initial_attitude, magnetometer_nis, magnetometer_update,
-    propagate_attitude, rotation_step, triad,
+    level, propagate_attitude, rotation_step, triad,
 )  # fmt: skip
 from .guidance import Navigation
 from .position_filter import (
@@ -86,8 +86,9 @@ class FilterParams:
     model's field at the pad [T, NED] and field_gradient (3, 3) its derivative along r_n [T/m] (the reference
     field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
     ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
-    the GNC ticks on the pad whose accelerometer and magnetometer samples initialise the attitude by TRIAD and whose
-    gyroscope samples the bias (0: from the rail, zero bias; static); horizontal_only: GNSS updates of north and
+    the GNC ticks on the pad whose samples initialise the attitude and whose gyroscope's mean the bias (0: from the
+    rail, zero bias; static); heading_from_field: the attitude by TRIAD from the accelerometer and magnetometer
+    (False: the rail's, levelled by the accelerometer: ``level``; static); horizontal_only: GNSS updates of north and
     east only (static); barometer: the barometric height update (static); field_gate, gnss_gate, altitude_gate: the
     innovation gates of the magnetometer's, the GNSS's and the barometer's updates (``innovation_gate``; None: off;
     static)."""
@@ -98,6 +99,7 @@ class FilterParams:
     field_gradient: jnp.ndarray
     gnss_after_s: jnp.ndarray
     pad_samples: int = static_field(default=0)
+    heading_from_field: bool = static_field(default=True)
     horizontal_only: bool = static_field(default=False)
     barometer: bool = static_field(default=False)
     field_gate: float | None = static_field(default=None)
@@ -158,7 +160,8 @@ class NavigationErrors:
 
 def initial_filters(params: FilterParams, q_nb0: Quat, r_n0: Vec3) -> FilterState:
     """At rest on the pad at t = 0: the attitude from the rail (``q_nb0``, the nominal rail's in a flight: what the
-    avionics know; replaced by TRIAD and the gyroscope's pad mean after the pad samples when ``params.pad_samples``),
+    avionics know; replaced by TRIAD or levelled, and the bias by the gyroscope's pad mean, after the pad samples when
+    ``params.pad_samples``),
     the position ``r_n0`` [m, NED] (the CG on that rail), at rest."""
     zero = jnp.zeros_like(q_nb0.w)
     still = Vec3(zero, zero, zero)
@@ -232,7 +235,8 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     attitude with the gyroscope's rates then; the magnetometer updates the attitude, the GNSS (after
     ``gnss_after_s``) and the barometer (when on) the position and velocity, each when fresh (and accepted by its gate,
     ``innovation_gate``; the rejections counted). On the pad (``moving`` False: liftoff not yet sensed) the pad sums
-    grow; after ``pad_samples`` ticks there TRIAD sets the attitude and the gyroscope's mean the bias (the rocket is
+    grow; after ``pad_samples`` ticks there the gyroscope's mean sets the bias and TRIAD the attitude (``heading_from_field``;
+    else the rail's attitude, held until then, levelled by the accelerometer's mean: ``level``; the rocket is
     at rest: the mean rate is the bias, plus the Earth's rotation, ≤ 7.3e-5 rad/s, which this flat, non-rotating
     Earth does not fly).
     ``idle`` (in a flight: every parachute triggered) or a failed covariance: the filters keep their state. Returns the a-posteriori
@@ -257,7 +261,12 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
     pad_pressure_count = state.pad_pressure_count + (on_pad & m.pressure_fresh)
     if params.pad_samples:
         aligned = on_pad & (pad_ticks == params.pad_samples)
-        aligned_attitude = initial_attitude(triad(pad_force_b, pad_field_b, reference), params.attitude)
+        if params.heading_from_field:
+            aligned_q_nb = triad(pad_force_b, pad_field_b, reference)
+        else:  # the rail's attitude held until levelled (the gyro's raw rates would turn it)
+            attitude = tree_where(on_pad & (pad_ticks <= params.pad_samples), state.attitude, attitude)
+            aligned_q_nb = level(attitude.q_nb, pad_force_b)
+        aligned_attitude = initial_attitude(aligned_q_nb, params.attitude)
         bias_b = pad_rate_b * (1.0 / jnp.maximum(pad_rate_count, 1))
         attitude = tree_where(aligned, dataclasses.replace(aligned_attitude, bias_b=bias_b), attitude)
 
