@@ -748,7 +748,7 @@ def build_parser() -> argparse.ArgumentParser:
         "budget", help="the GNC error budget: a closed-loop campaign flown with each navigation error source alone",
         description="Fly a closed-loop campaign (navigation 'filters' or 'sensors') with each navigation error source "
         "alone, with all (the campaign), with none (the navigation on perfect sensors and the truth's field), on perfect navigation and "
-        "with the controller off, every row with the same seed and N (the same winds and draws): the 95 %% landing "
+        "with the controller off, every row with the same seed and N (the same winds and draws): the 95 % landing "
         "ellipse of each row, its paired ratios to the others, the navigation and control errors and the failed "
         "flights. One compilation per row flown; no result file.",
     )  # fmt: skip
