@@ -213,6 +213,21 @@ def test_unclipped_normal_is_checked_at_six_std():
     assert "mean + 6·std; clip it with high" in message and "launch.elevation_deg: Input should be less" in message
 
 
+def test_a_sensor_spread_drawing_out_of_range_names_the_spread():
+    """A per-flight spread is a dispersion the file does not write (``sensor_spreads``): a gyroscope misaligned by
+    2° per flight draws 6·2° beyond misalignment_deg's ±10°; the line names the spread the file gives, and the way
+    out it offers (a dispersion of the drawn value, clipped) loads."""
+    raw = {**EXPANDED, "avionics": {"gyroscope": {"misalignment_std_deg": 2.0}}}
+    message = refusal(raw)
+    assert message.startswith("avionics.gyroscope.misalignment_std_deg: draws -12.0 (the nominal − 6·std), out of "
+                              "range: avionics.gyroscope.misalignment_deg.0: Input should be greater than or equal to "
+                              "-10"), message  # fmt: skip
+    clipped = {f"avionics.gyroscope.misalignment_deg.{i}": {"dist": "normal", "std": 2.0, "low": -10.0, "high": 10.0}
+               for i in range(3)}  # fmt: skip
+    campaign = campaign_from_dict({**raw, "dispersions": {**EXPANDED["dispersions"], **clipped}}, CAMPAIGNS)
+    assert campaign.config.dispersions["avionics.gyroscope.misalignment_deg.1"].low == -10.0
+
+
 @pytest.mark.parametrize(("factor", "valid"), [(0.99, True), (1.01, False)])
 def test_unclipped_reach_is_six_std_exactly(factor, valid):
     """Drogue cd 0.9 (> 0): std = factor · 0.9/6 puts mean − 6·std just inside or just outside the range;
