@@ -1,5 +1,6 @@
 """Runs on Dask (``run --workers N`` / ``--scheduler ADDRESS``): a two-worker local cluster writes the
-bits of a local run, also when resuming, stopping early or losing a worker mid-run; a scheduler that
+bits of a local run (the full GNC with every error source and every fault on, tests/campaign/error_sources.py),
+also when resuming, stopping early or losing a worker mid-run; a scheduler that
 cannot be reached (or a port that never answers, answers garbage or closes at once), a missing 'dask'
 extra and bad options are one line and exit code 2."""
 
@@ -14,6 +15,7 @@ import sys
 import threading
 import time
 from contextlib import contextmanager
+from pathlib import Path
 
 import dask
 import jax
@@ -28,18 +30,27 @@ from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
 from ..conftest import CAMPAIGNS
+from .error_sources import assert_every_fault_recorded, write_every_error_source
 from .test_resume import assert_same, contents
 
 CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")  # the full GNC: sensors, navigation filters, controller
+# (the bits are compared on it with every error source and fault on, ``faulted``; the other tests fly nothing)
 N, CHUNK, SEED = 16, 2, 7  # 8 chunks of ~0.5 s on one worker core once compiled
 ARGS = ["-n", str(N), "--chunk-size", str(CHUNK), "--seed", str(SEED)]
 
 
-def test_two_workers_write_the_local_bits(tmp_path, monkeypatch):
+@pytest.fixture(scope="module")
+def faulted(tmp_path_factory) -> str:
+    """The campaign the bits are compared on: CAMPAIGN with every error source and every fault on."""
+    return str(write_every_error_source(Path(CAMPAIGN), tmp_path_factory.mktemp("campaign")))
+
+
+def test_two_workers_write_the_local_bits(tmp_path, monkeypatch, faulted):
     # One test for the whole cluster: pytest-xdist may split a module's tests between its processes,
-    # and each would start its own cluster (one compilation per worker, ~30 s on one core).
-    assert main(["run", CAMPAIGN, *ARGS, "--out", str(tmp_path / "local.h5"), "--quiet"]) == 0
+    # and each would start its own cluster (one compilation per worker, ~45 s on one core).
+    assert main(["run", faulted, *ARGS, "--out", str(tmp_path / "local.h5"), "--quiet"]) == 0
     want, want_attrs = contents(tmp_path / "local.h5")
+    assert_every_fault_recorded(want, N)
     # A worker restarted after a kill loads the chunk function from JAX's disk cache (seconds)
     # instead of compiling it again; the first ones compile as usual.
     monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", str(tmp_path / "jax_cache"))
@@ -53,20 +64,20 @@ def test_two_workers_write_the_local_bits(tmp_path, monkeypatch):
         # otherwise than the local run's: the bits must not depend on it.
         assert client.run(jax.local_device_count) == dict.fromkeys(client.nthreads(), max(1, jax.local_device_count() // 2))
         address = client.scheduler_info()["address"]
-        assert main(["run", CAMPAIGN, *ARGS, "--out", str(tmp_path / "dask.h5"), "--quiet", "--scheduler", address]) == 0
+        assert main(["run", faulted, *ARGS, "--out", str(tmp_path / "dask.h5"), "--quiet", "--scheduler", address]) == 0
         got, got_attrs = contents(tmp_path / "dask.h5")
         assert_same(got, want)
         assert got_attrs["campaign_toml"] == want_attrs["campaign_toml"]
         assert list(got_attrs["completed_chunks"]) == list(range(N // CHUNK))
 
-        campaign = load_campaign(CAMPAIGN).with_overrides(n_realizations=N, seed=SEED)
-        resumes(address, campaign, want, tmp_path / "resumed.h5")
+        campaign = load_campaign(faulted).with_overrides(n_realizations=N, seed=SEED)
+        resumes(address, faulted, campaign, want, tmp_path / "resumed.h5")
         stops_early(client, campaign)
         refuses_workers_unlike_the_client(client, campaign)
         survives_a_killed_worker(client, campaign, want)  # last: the restarted worker compiles again
 
 
-def resumes(address: str, campaign, want: dict, out) -> None:
+def resumes(address: str, path: str, campaign, want: dict, out) -> None:
     """A killed run left chunks 0, 3 and 5 (taken from the local run): the cluster flies the others,
     out of the usual order, and the file is the local run's."""
     writer = ResultWriter(out, campaign, CHUNK)
@@ -74,7 +85,7 @@ def resumes(address: str, campaign, want: dict, out) -> None:
         rows = slice(CHUNK * index, CHUNK * (index + 1))
         part = {group: {k.split("/")[1]: v[rows] for k, v in want.items() if k.startswith(group)} for group in ("outputs", "inputs")}
         writer.write(ChunkResult(CHUNK * index, part["outputs"], part["inputs"], 0.0), index)
-    assert main(["run", CAMPAIGN, *ARGS, "--out", str(out), "--quiet", "--resume", "--scheduler", address]) == 0
+    assert main(["run", path, *ARGS, "--out", str(out), "--quiet", "--resume", "--scheduler", address]) == 0
     assert_same(contents(out)[0], want)
 
 
@@ -126,12 +137,13 @@ def survives_a_killed_worker(client, campaign, want: dict) -> None:
     assert any(n > 1 for n in flown.values())  # the victim's chunk(s) were flown again
 
 
-def test_the_set_up_fingerprint_is_the_same_in_every_process():
-    # The compiled chunk functions are kept under it, and resumed runs are checked against it.
+def test_the_set_up_fingerprint_is_the_same_in_every_process(faulted):
+    # The compiled chunk functions are kept under it, and resumed runs are checked against it (the campaign's
+    # guidance reference derived and its IGRF-14 field evaluated in each process).
     code = ("from rocketmc.campaign import load_campaign; from rocketmc.campaign.fingerprint import fingerprint, setup; "
-            f"print(fingerprint(setup(load_campaign({CAMPAIGN!r}), 8)))")  # fmt: skip
+            f"print(fingerprint(setup(load_campaign({faulted!r}), 8)))")  # fmt: skip
     found = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
-    assert found == fingerprint(setup(load_campaign(CAMPAIGN), 8))
+    assert found == fingerprint(setup(load_campaign(faulted), 8))
 
 
 @contextmanager

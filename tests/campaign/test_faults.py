@@ -186,9 +186,38 @@ def test_report_prints_a_line_per_fault(tmp_path, capsys):
     ("[faults.leaky_tank]\nprobability = 0.5", "faults.leaky_tank"),
     ("[faults.gyroscope_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_deg_s = 1.0",
      "faults.gyroscope_bias_jump"),
+    ("[faults.stuck_canard]\ntime_s = [1.0, 2.0]", "faults.stuck_canard.probability"),
+    ("[faults.stuck_canard]\nprobability = 'often'\ntime_s = [1.0, 2.0]", "faults.stuck_canard.probability"),
+    ("[faults.gnss_outage]\nprobability = 0.5\nstart_s = [1.0, 2.0]\nduration_s = [3.0, 1.0]",
+     "faults.gnss_outage.duration_s"),
+    ("[faults.gnss_outage]\nprobability = 0.5\nduration_s = [1.0, 1.0]", "faults.gnss_outage.start_s"),
+    ("[faults.stuck_canard]\nprobability = 0.5\ntime_s = [1.0, 1e9]", "faults.stuck_canard.time_s.1"),
+    ("[faults.stuck_canard]\nprobability = 0.5\ntime_s = [nan, 2.0]", "faults.stuck_canard.time_s.0"),
+    ("[faults.stuck_canard]\nprobability = 0.5\ntime_s = 1.0", "faults.stuck_canard.time_s"),
+    ("[faults.magnetometer_step]\nprobability = 0.5\nmagnitude_ut = 20.0", "faults.magnetometer_step.time_s"),
+    ("[faults.stuck_canard]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nfin = 2.5", "faults.stuck_canard.fin"),
+    ("[faults.slow_canard]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nfactor = 2.0\nfin = 0", "faults.slow_canard.fin"),
+    ("[faults.stuck_canard]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nangle_deg = nan", "faults.stuck_canard.angle_deg"),
+    ("[faults.slow_canard]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nfactor = 200.0", "faults.slow_canard.factor"),
+    ("[faults.magnetometer_step]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_ut = 2e4",
+     "faults.magnetometer_step.magnitude_ut"),
+    ("[faults.gyroscope_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_deg_s = 1e4",
+     "faults.gyroscope_bias_jump.magnitude_deg_s"),
+    ("[faults.gyroscope_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_deg_s = inf",
+     "faults.gyroscope_bias_jump.magnitude_deg_s"),
+    ("[faults.accelerometer_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_mps2 = -0.5",
+     "faults.accelerometer_bias_jump.magnitude_mps2"),
+    ("[faults.accelerometer_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]",
+     "faults.accelerometer_bias_jump.magnitude_mps2"),
+    ("[faults]\nstuck_canard = 0.5", "faults.stuck_canard"),
+    ("[faults.stuck_canard]\nprobability = 0.0\ntime_s = [1.0, 2.0]\nfin = 9",
+     "faults.stuck_canard.fin"),  # off, still checked
 ], ids=["probability-above-1", "probability-negative", "probability-nan", "window-reversed", "window-one-value",
         "fin-5", "negative-time", "angle-90", "factor-below-1", "factor-missing", "zero-magnitude", "unknown-key",
-        "unknown-fault", "jump-on-truth-only"])  # fmt: skip
+        "unknown-fault", "jump-on-truth-only", "probability-missing", "probability-text", "duration-reversed",
+        "start-missing", "time-beyond-max-flight", "time-nan", "time-not-a-window", "time-missing", "fin-not-whole",
+        "fin-0", "angle-nan", "factor-above-100", "step-above-10000-ut", "jump-above-max-rate", "jump-inf",
+        "negative-jump", "jump-magnitude-missing", "fault-not-a-table", "fin-5-at-probability-0"])  # fmt: skip
 def test_bad_faults_refused_with_one_line_and_no_file(tmp_path, capsys, faults, field):
     """Each refused as one ``rocketmc: error: ... <field>: ...`` line, exit code 2, nothing written (the bias jump
     on a truth-only gyroscope: the campaign's gyroscope made one)."""
@@ -203,6 +232,45 @@ def test_bad_faults_refused_with_one_line_and_no_file(tmp_path, capsys, faults, 
     assert set(tmp_path.iterdir()) == before
 
 
+@pytest.mark.parametrize("campaign, edit, faults, message", [
+    ("lynx_nominal.toml", None, "[faults.slow_canard]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nfactor = 2.0",
+     "faults.slow_canard: needs [gnc]"),
+    ("lynx_ballistic_ctrl_1s.toml", None, "[faults.magnetometer_step]\nprobability = 0.5\ntime_s = [1.0, 2.0]\n"
+     "magnitude_ut = 20.0", "faults.magnetometer_step: needs [avionics]"),
+    ("lynx_ballistic_ctrl_1s.toml", None, "[faults.accelerometer_bias_jump]\nprobability = 1.0\ntime_s = [1.0, 2.0]\n"
+     "magnitude_mps2 = 0.5", "faults.accelerometer_bias_jump: needs [avionics]"),
+    ("lynx_ballistic_gnc_1s.toml", (TRUTH_ONLY_GYRO[0], TRUTH_ONLY_GYRO[0] + "accelerometer = { truth_only = true }\n"),
+     "[faults.accelerometer_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_mps2 = 0.5",
+     "faults.accelerometer_bias_jump: avionics.accelerometer is truth_only"),
+    ("lynx_ballistic_gnc_1s.toml", (TRUTH_ONLY_GYRO[0], TRUTH_ONLY_GYRO[0] + "truth_only = true\n"),  # every sensor's
+     "[faults.gyroscope_bias_jump]\nprobability = 0.5\ntime_s = [1.0, 2.0]\nmagnitude_deg_s = 1.0",
+     "faults.gyroscope_bias_jump: avionics.gyroscope is truth_only"),
+], ids=["canard-fault-without-gnc", "magnetometer-step-without-avionics", "bias-jump-without-avionics",
+        "jump-on-truth-only-accelerometer", "jump-on-truth-only-avionics"])  # fmt: skip
+def test_fault_on_what_the_campaign_does_not_fly_refused_by_run(tmp_path, capsys, campaign, edit, faults, message):
+    """``rocketmc run`` on a fault whose servos or sensors the campaign does not fly (or flies without errors): one
+    line naming the fault, exit code 2, nothing written."""
+    text = (CAMPAIGNS / campaign).read_text()
+    if edit is not None:
+        assert text.count(edit[0]) == 1
+        text = text.replace(*edit)
+    path = tmp_path / "bad.toml"
+    path.write_text(text + "\n" + faults + "\n")
+    before = set(tmp_path.iterdir())
+    assert main(["run", str(path), "--out", str(tmp_path / "x.h5")]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"rocketmc: error: {path}: {message}"), lines
+    assert set(tmp_path.iterdir()) == before
+
+
+def test_a_fault_at_probability_zero_needs_nothing():
+    """A fault at probability 0 is off: it needs no section (a canard fault on a campaign without [gnc] loads) and
+    leaves no fault active."""
+    raw = tomllib.loads((CAMPAIGNS / "lynx_nominal.toml").read_text())
+    raw["faults"] = {"stuck_canard": {"probability": 0.0, "time_s": [1.0, 2.0]}}
+    assert campaign_from_dict(raw, CAMPAIGNS).config.faults.active() == {}
+
+
 @pytest.mark.parametrize("campaign, fault, section", [
     ("lynx_nominal.toml", "stuck_canard", "gnc"), ("lynx_ballistic_ctrl_1s.toml", "gnss_outage", "avionics")])
 def test_fault_without_its_section_is_refused(campaign, fault, section):
@@ -210,5 +278,5 @@ def test_fault_without_its_section_is_refused(campaign, fault, section):
     raw = tomllib.loads((CAMPAIGNS / campaign).read_text())
     raw["faults"] = {fault: {"probability": 0.5, "time_s": [1.0, 2.0]} if fault == "stuck_canard" else
                      {"probability": 0.5, "start_s": [1.0, 2.0], "duration_s": [1.0, 1.0]}}  # fmt: skip
-    with pytest.raises(Exception, match=rf"^faults\.{fault}: needs a \[{section}\] section"):
+    with pytest.raises(Exception, match=rf"^faults\.{fault}: needs \[{section}\]"):
         campaign_from_dict(raw, CAMPAIGNS)

@@ -213,6 +213,21 @@ def test_unclipped_normal_is_checked_at_six_std():
     assert "mean + 6·std; clip it with high" in message and "launch.elevation_deg: Input should be less" in message
 
 
+def test_a_sensor_spread_drawing_out_of_range_names_the_spread():
+    """A per-flight spread is a dispersion the file does not write (``sensor_spreads``): a gyroscope misaligned by
+    2° per flight draws 6·2° beyond misalignment_deg's ±10°; the line names the spread the file gives, and the way
+    out it offers (a dispersion of the drawn value, clipped) loads."""
+    raw = {**EXPANDED, "avionics": {"gyroscope": {"misalignment_std_deg": 2.0}}}
+    message = refusal(raw)
+    assert message.startswith("avionics.gyroscope.misalignment_std_deg: draws -12.0 (the nominal − 6·std), out of "
+                              "range: avionics.gyroscope.misalignment_deg.0: Input should be greater than or equal to "
+                              "-10"), message  # fmt: skip
+    clipped = {f"avionics.gyroscope.misalignment_deg.{i}": {"dist": "normal", "std": 2.0, "low": -10.0, "high": 10.0}
+               for i in range(3)}  # fmt: skip
+    campaign = campaign_from_dict({**raw, "dispersions": {**EXPANDED["dispersions"], **clipped}}, CAMPAIGNS)
+    assert campaign.config.dispersions["avionics.gyroscope.misalignment_deg.1"].low == -10.0
+
+
 @pytest.mark.parametrize(("factor", "valid"), [(0.99, True), (1.01, False)])
 def test_unclipped_reach_is_six_std_exactly(factor, valid):
     """Drogue cd 0.9 (> 0): std = factor · 0.9/6 puts mean − 6·std just inside or just outside the range;
@@ -371,6 +386,54 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
          '[gnc.filters]\ninitialisation = "level"', "gnc.filters.initialisation"),
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[gnc]\nnavigation = "filters"', "gnc.navigation"),
+        # [environment.magnetic_field]: the truth's model, the IGRF-14's dates, the anomaly and its draws
+        ('model = "dipole"', 'model = "wmm"', "environment.magnetic_field.model"),
+        ('model = "dipole"', 'model = "igrf"\ndate = "2031-01-01"', "environment.magnetic_field.date"),
+        ('model = "dipole"', "date = 1899-12-31", "environment.magnetic_field.date"),  # a TOML date
+        ('model = "dipole"', 'date = "18/09/2021"', "environment.magnetic_field.date"),
+        ('model = "dipole"', "anomaly_nt = [0.0, 2e5, 0.0]", "environment.magnetic_field.anomaly_nt.1"),
+        ('model = "dipole"', "anomaly_nt = [nan, 0.0, 0.0]", "environment.magnetic_field.anomaly_nt.0"),
+        ('model = "dipole"', "anomaly_nt = [0.0, 0.0]", "environment.magnetic_field.anomaly_nt"),
+        ("[dispersions]", '[dispersions]\n"environment.magnetic_field.anomaly_nt.0" = { dist = "normal", std = 2e4 }',
+         "dispersions.environment.magnetic_field.anomaly_nt.0"),
+        ("[dispersions]", '[dispersions]\n"environment.magnetic_field.date" = { dist = "normal", std = 1.0 }',
+         "dispersions.environment.magnetic_field.date"),
+        # The magnetometer's iron spreads; a spread whose draws leave the value's range names the spread
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[avionics.magnetometer]\nsoft_iron_std = 0.6",
+         "avionics.magnetometer.soft_iron_std"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[avionics.magnetometer]\nsoft_iron_std = nan",
+         "avionics.magnetometer.soft_iron_std"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[avionics.magnetometer]\nhard_iron_std = -1.0",
+         "avionics.magnetometer.hard_iron_std"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[avionics.magnetometer]\nhard_iron_std = 5e6",
+         "avionics.magnetometer.hard_iron_std"),  # 6·std beyond the ±1e7 µT of hard_iron
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[avionics.magnetometer]\nsoft_iron_std = 0.5\n"
+         "soft_iron = [9.9, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]", "avionics.magnetometer.soft_iron_std"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[avionics.gyroscope]\nmisalignment_std_deg = 2.0",
+         "avionics.gyroscope.misalignment_std_deg"),  # 6·2° beyond the ±10° of misalignment_deg
+        ("[dispersions]", '[avionics]\n\n[dispersions]\n"avionics.magnetometer.soft_iron_std" = { dist = "normal", '
+         "std = 0.01 }", "dispersions.avionics.magnetometer.soft_iron_std"),
+        # The filters' field model and pad initialisation
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
+         '[gnc.filters.attitude]\nfield_model = "wmm"', "gnc.filters.attitude.field_model"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[avionics]\n\n[gnc]\nnavigation = "filters"\n\n'
+         "[gnc.filters]\npad_samples = 2.5", "gnc.filters.pad_samples"),
+        ("[dispersions]", '[avionics]\n\n[gnc]\nnavigation = "filters"\n\n[gnc.filters]\ninitialisation = "pad"\n'
+         'pad_samples = 20\n\n[dispersions]\n"rocket.motor.ignition_delay_s" = { dist = "uniform", low = 0.1, '
+         "high = 1.0 }", "gnc.filters.initialisation"),  # 0.4 s of pad samples, ignition from 0.1 s
+        ("[dispersions]", '[avionics]\n\n[gnc]\nnavigation = "filters"\n\n[dispersions]\n'
+         '"gnc.filters.pad_samples" = { dist = "uniform", low = 1.0, high = 10.0 }',
+         "dispersions.gnc.filters.pad_samples"),
+        # The guidance reference, each field set or derived from the campaign
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[gnc.guidance]\napogee_m = 0.0", "gnc.guidance.apogee_m"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[gnc.guidance]\nflight_path_angle_deg = nan",
+         "gnc.guidance.flight_path_angle_deg"),
+        ("chunk_size = 1000", 'chunk_size = 1000\n\n[gnc.guidance]\nroll_heading_deg = "east"',
+         "gnc.guidance.roll_heading_deg"),
+        ("chunk_size = 1000", "chunk_size = 1000\n\n[rocket.aero]\nmodel = \"linear\"\n\n[gnc.guidance]\nt0_s = 60.0",
+         "gnc.guidance.apogee_m"),  # derived: the nominal flight does not climb after 60 s
+        ("[dispersions]", '[gnc]\n\n[dispersions]\n"gnc.guidance.apogee_m" = { dist = "normal", std = 10.0 }',
+         "dispersions.gnc.guidance.apogee_m"),
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
          "long-name", "binary-thrust-file", "binary-aero-csv", "elevation-above-90", "negative-mass", "missing-n",
@@ -379,7 +442,14 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "unknown-part", "part-without-the-sensor", "negative-noise-density", "rate-not-dividing-the-gnc-rate",
          "range-without-zero", "latency-between-ticks", "sensor-navigation-without-avionics", "sensor-rate-dispersed",
          "filter-covariance-zero", "filter-covariance-negative", "pad-initialisation-without-pad-time",
-         "level-initialisation-without-pad-time", "filters-without-avionics"],
+         "level-initialisation-without-pad-time", "filters-without-avionics", "unknown-field-model",
+         "igrf-date-after-2030", "toml-date-before-1900",
+         "date-not-iso", "anomaly-beyond-1e5-nt", "anomaly-nan", "anomaly-two-axes", "anomaly-draws-out-of-range",
+         "date-dispersed", "soft-iron-spread-above-0.5", "soft-iron-spread-nan", "negative-hard-iron-spread",
+         "hard-iron-spread-draws-out-of-range", "soft-iron-spread-draws-out-of-range",
+         "misalignment-spread-draws-out-of-range", "soft-iron-spread-dispersed", "unknown-filter-field-model",
+         "pad-samples-not-whole", "pad-time-against-dispersed-ignition", "pad-samples-dispersed", "apogee-zero",
+         "flight-path-angle-nan", "roll-heading-text", "derived-apogee-after-the-climb", "apogee-dispersed"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old

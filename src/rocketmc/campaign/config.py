@@ -1302,10 +1302,15 @@ def fixed_reason(path: str) -> str | None:
 
 
 def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> None:
-    """Each dispersion names a dispersible number and every value it can draw passes validation."""
+    """Each dispersion names a dispersible number and every value it can draw passes validation; one a sensor's
+    per-flight spread implies (``sensor_spreads``) is named by that spread, the field the file gives."""
     data = config.model_dump(exclude={"dispersions"})
+    implied = sensor_spreads(config)
     for path, d in config.dispersions.items():
         field = f"dispersions.{path}"
+        if implied.get(path) == d:
+            _check_spread_draws(data, path, d, nominal[path])
+            continue
         if (reason := fixed_reason(path)) is not None:
             raise ConfigError(f"{field}: {reason}")
         if path.startswith("environment.wind.") and config.environment.atmosphere is not None:
@@ -1320,6 +1325,21 @@ def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> Non
             except ValidationError as e:
                 raise ConfigError(f"{field}: draws a value {value!r}{hint} that is out of range: "
                                   f"{_format_error(e)}") from None  # fmt: skip
+
+
+def _check_spread_draws(data: dict, path: str, d: Dispersion, nominal_value: float) -> None:
+    """ConfigError naming the spread (``avionics.<sensor>.<spread>``) if the draws it implies at ``path``
+    (``avionics.<sensor>.<value>.<i>``, normal about the nominal value, unclipped) can leave the value's range."""
+    sensor, target = path.split(".")[1:3]
+    spread = f"avionics.{sensor}.{next(name for name, value in SPREADS.items() if value == target)}"
+    reach = NORMAL_REACH_STD * d.std
+    for sign, value in (("−", nominal_value - reach), ("+", nominal_value + reach)):
+        try:
+            CampaignConfig.model_validate(_set_path(data, path, value))
+        except ValidationError as e:
+            raise ConfigError(f"{spread}: draws {value!r} (the nominal {sign} {NORMAL_REACH_STD:g}·std), out of "
+                              f"range: {_format_error(e)}; lower it, or clip the draws with a dispersion of that "
+                              "path (low, high)") from None  # fmt: skip
 
 
 def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
@@ -1462,7 +1482,7 @@ def _check_faults(config: CampaignConfig) -> None:
         section = FAULT_SECTIONS[name]
         if getattr(config, section) is None:
             acts_on = "the canard servos" if section == "gnc" else "the sensors"
-            raise ConfigError(f"faults.{name}: needs a [{section}] section ({acts_on} it acts on)")
+            raise ConfigError(f"faults.{name}: needs [{section}] ({acts_on} it acts on)")
         sensor = name.removesuffix("_bias_jump")
         if sensor != name and getattr(config.avionics, sensor).truth_only:
             raise ConfigError(f"faults.{name}: avionics.{sensor} is truth_only (no errors, so no bias to jump)")
