@@ -314,6 +314,18 @@ def test_level_points_the_measured_up_up_and_does_not_roll():
     assert 0.4 < np.linalg.norm(turn_b) < 0.6 and abs(turn_b[0]) < np.sin(np.radians(6.0)) * np.linalg.norm(turn_b)
 
 
+def test_level_by_a_fraction_turns_the_tilt_by_that_fraction():
+    """A fraction of the levelling (the rail's tilt weighed against the accelerometer's): 0 keeps the nominal, ½ turns
+    the body's up halfway from the nominal's to the measured one, about the same axis (roundoff)."""
+    nominal, true = rail(84.0, 131.0, 0.0), rail(84.6, 130.0, 3.0)
+    force_b = true.inv().apply([0.0, 0.0, -9.80665])
+    full = Rotation.from_matrix(dcm(level(quat(nominal), vec(force_b))))
+    for fraction in (0.0, 0.5):
+        got = Rotation.from_matrix(dcm(level(quat(nominal), vec(force_b), fraction)))
+        np.testing.assert_allclose((nominal.inv() * got).as_rotvec(), fraction * (nominal.inv() * full).as_rotvec(),
+                                   rtol=0, atol=1e-15)  # fmt: skip
+
+
 # --- consistency ----------------------------------------------------------------------------------------------
 
 MC_TUNING = AttitudeTuning(

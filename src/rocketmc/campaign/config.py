@@ -723,6 +723,11 @@ class FiltersConfig(_Strict):
                             "nominal rail's levelled by the pad's accelerometer, and the gyro's pad mean")  # fmt: skip
     pad_samples: int = Field(500, ge=1, le=100_000, description="GNC ticks on the pad averaged for TRIAD and the "
                                                                  "gyro bias (\"pad\", \"level\")")  # fmt: skip
+    rail_tilt_std_deg: float | None = Field(
+        None, ge=0, le=MAX_MISALIGNMENT_DEG, description="how far the avionics believe the rail's tilt can be off the "
+        "nominal, per axis (\"level\"): the levelling turns the nominal's tilt toward the accelerometer's by "
+        "σ_rail²/(σ_rail² + σ_accel²), σ_accel the accelerometer's spread of bias over g0 and of misalignment; none: "
+        "all the way")  # fmt: skip
     attitude: AttitudeFilterConfig = AttitudeFilterConfig()
     position: PositionFilterConfig = PositionFilterConfig()
 

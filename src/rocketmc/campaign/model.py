@@ -20,7 +20,7 @@ from ..dynamics.propulsion import cumulative_impulse
 from ..dynamics.rigid_body import combine_on_axis
 from ..dynamics.servo import ServoParams
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
-from ..env.atmosphere import AtmosphereProfile
+from ..env.atmosphere import G0, AtmosphereProfile
 from ..env.weather import geometric_altitude
 from ..gnc.control import GAIN_NAMES, GncParams
 from ..gnc.attitude_filter import AttitudeTuning
@@ -251,8 +251,23 @@ def filter_params(campaign: Campaign) -> FilterParams:
         field_t, gradient = (site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m)
                              if model == "dipole" else _igrf(config))  # fmt: skip
     return FilterParams(attitude, position, jnp.asarray(field_t), jnp.asarray(gradient), jnp.asarray(p.gnss_after_s),
-                        0 if f.initialisation == "rail" else f.pad_samples, f.initialisation == "pad",
-                        p.gnss == "horizontal", p.barometer, a.field_gate, p.gnss_gate, p.altitude_gate)  # fmt: skip
+                        jnp.asarray(level_fraction(config)), 0 if f.initialisation == "rail" else f.pad_samples,
+                        f.initialisation == "pad", p.gnss == "horizontal", p.barometer, a.field_gate, p.gnss_gate,
+                        p.altitude_gate)  # fmt: skip
+
+
+def level_fraction(config) -> float:
+    """How far the pad's levelling turns the nominal rail's tilt toward the accelerometer's [-]: the minimum-variance
+    weight σ_rail²/(σ_rail² + σ_accel²) of ``gnc.filters.rail_tilt_std_deg`` against the accelerometer's tilt error,
+    its bias spread over g0 and its misalignment spread (RSS of the largest axis's; 0 for a truth-only one); 1
+    without a rail std or without [avionics]."""
+    rail_deg = None if config.gnc is None else config.gnc.filters.rail_tilt_std_deg
+    if rail_deg is None or config.avionics is None:
+        return 1.0
+    accel = config.avionics.accelerometer
+    accel_deg = 0.0 if accel.truth_only else math.hypot(math.degrees(max(accel.bias_std) / G0), accel.misalignment_std_deg)
+    total = rail_deg**2 + accel_deg**2
+    return 1.0 if total == 0.0 else rail_deg**2 / total
 
 
 SENSOR_UNITS = {"accelerometer": 1.0, "gyroscope": math.pi / 180.0, "magnetometer": 1e-6, "barometer": 1.0,

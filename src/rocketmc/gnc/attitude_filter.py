@@ -322,15 +322,19 @@ def triad(specific_force_b: Vec3, field_b: Vec3, field_n: Vec3) -> Quat:
     return _quat_from_matrix(rotation)
 
 
-def level(q_nb: Quat, specific_force_b: Vec3) -> Quat:
-    """q_nb turned by the least rotation that makes the specific force f_b (at rest on the pad: "up", (0, 0, −g0) in
-    NED) point up: the attitude's tilt from the accelerometer, its rotation about the vertical (for a rocket on its
-    rail: the rail's azimuth and the rocket's roll on it) kept as given to first order. The body-frame rotation is the
-    shortest arc from f_b to q_nb's own up, (1 + a·b, a × b) normalised; f_b must not point down in q_nb."""
+def level(q_nb: Quat, specific_force_b: Vec3, fraction=1.0) -> Quat:
+    """q_nb turned by ``fraction`` [-] of the least rotation that makes the specific force f_b (at rest on the pad:
+    "up", (0, 0, −g0) in NED) point up: at 1 the attitude's tilt is the accelerometer's, its rotation about the
+    vertical (for a rocket on its rail: the rail's azimuth and the rocket's roll on it) kept as given to first order;
+    below 1 the tilt is a weighted mean of the two. The rotation is about the body axis f_b × q_nb's own up, by
+    ``fraction`` of the angle between them; f_b must not point down in q_nb."""
     up_n = Vec3(jnp.zeros_like(q_nb.w), jnp.zeros_like(q_nb.w), -jnp.ones_like(q_nb.w))
     measured_b, predicted_b = _unit(specific_force_b), q_nb.rotate_inverse(up_n)
     axis_b = measured_b.cross(predicted_b)
-    return q_nb * Quat(1.0 + measured_b.dot(predicted_b), axis_b.x, axis_b.y, axis_b.z).normalized()
+    sine = axis_b.norm()
+    half_angle = 0.5 * fraction * jnp.arctan2(sine, measured_b.dot(predicted_b))
+    scale = jnp.where(sine > 1e-300, jnp.sin(half_angle) / jnp.where(sine > 1e-300, sine, 1.0), 0.5 * fraction)
+    return q_nb * Quat(jnp.cos(half_angle), axis_b.x * scale, axis_b.y * scale, axis_b.z * scale)
 
 
 def attitude_error_b(q_estimate: Quat, q_true: Quat) -> Vec3:

@@ -85,7 +85,8 @@ class FilterParams:
     """The navigation filters of one flight. attitude, position: their tunings; field_n (3,): the geomagnetic
     model's field at the pad [T, NED] and field_gradient (3, 3) its derivative along r_n [T/m] (the reference
     field direction at the estimated position, to first order: the dipole's second-order term over 10 km is
-    ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; pad_samples:
+    ~3e-6 of the field); gnss_after_s: the position filter uses fixes from this simulation time [s]; level_fraction:
+    how far the levelling turns the rail's tilt toward the accelerometer's [-] (``level``); pad_samples:
     the GNC ticks on the pad whose samples initialise the attitude and whose gyroscope's mean the bias (0: from the
     rail, zero bias; static); heading_from_field: the attitude by TRIAD from the accelerometer and magnetometer
     (False: the rail's, levelled by the accelerometer: ``level``; static); horizontal_only: GNSS updates of north and
@@ -98,6 +99,7 @@ class FilterParams:
     field_n: jnp.ndarray
     field_gradient: jnp.ndarray
     gnss_after_s: jnp.ndarray
+    level_fraction: jnp.ndarray = 1.0
     pad_samples: int = static_field(default=0)
     heading_from_field: bool = static_field(default=True)
     horizontal_only: bool = static_field(default=False)
@@ -265,7 +267,7 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
             aligned_q_nb = triad(pad_force_b, pad_field_b, reference)
         else:  # the rail's attitude held until levelled (the gyro's raw rates would turn it)
             attitude = tree_where(on_pad & (pad_ticks <= params.pad_samples), state.attitude, attitude)
-            aligned_q_nb = level(attitude.q_nb, pad_force_b)
+            aligned_q_nb = level(attitude.q_nb, pad_force_b, params.level_fraction)
         aligned_attitude = initial_attitude(aligned_q_nb, params.attitude)
         bias_b = pad_rate_b * (1.0 / jnp.maximum(pad_rate_count, 1))
         attitude = tree_where(aligned, dataclasses.replace(aligned_attitude, bias_b=bias_b), attitude)
