@@ -126,12 +126,14 @@ def test_shipped_campaigns_load(path):
     simulation = config.simulation.model_dump()
     assert {k: simulation[k] for k in data.get("simulation", {})} == data.get("simulation", {})
     # the file's dispersions, after those its sensors' per-flight spreads imply (normal, about the nominal value)
+    upper = {"cross_axis": range(6), "soft_iron": (0, 1, 2, 4, 5, 8)}  # the soft-iron matrix's upper triangle
     spreads = {f"avionics.{sensor}.{target}.{i}": std
                for sensor, table in written["avionics"].items() for spread, target in
                (("bias_std", "bias"), ("scale_factor_std", "scale_factor"), ("cross_axis_std", "cross_axis"),
-                ("misalignment_std_deg", "misalignment_deg"), ("hard_iron_std", "hard_iron")) if spread in table
-               for i, std in enumerate(table[spread] if isinstance(table[spread], list) else
-                                       [table[spread]] * {"cross_axis": 6}.get(target, 3)) if std > 0}  # fmt: skip
+                ("misalignment_std_deg", "misalignment_deg"), ("hard_iron_std", "hard_iron"),
+                ("soft_iron_std", "soft_iron")) if spread in table
+               for i, std in (enumerate(table[spread]) if isinstance(table[spread], list) else
+                              ((i, table[spread]) for i in upper.get(target, range(3)))) if std > 0}  # fmt: skip
     assert list(config.dispersions) == [*spreads, *(k for k in data.get("dispersions", {}) if k not in spreads)]
     for key, std in spreads.items():
         assert config.dispersions[key].model_dump(exclude_none=True) == {"dist": "normal", "std": std}, key

@@ -18,41 +18,12 @@ from rocketmc.campaign.sampling import realization_key, sample_faults
 from rocketmc.cli import main
 
 from ..conftest import CAMPAIGNS
+from .error_sources import FAULT_KINDS as KINDS
+from .error_sources import FAULTS as EVERY_FAULT
 from .test_runner import collect
 
 GNC = (CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text()
-FAULTS = """
-[faults.stuck_canard]
-probability = 0.3
-time_s = [2.0, 6.0]
-
-[faults.slow_canard]
-probability = 0.3
-time_s = [1.0, 3.0]
-factor = 4.0
-
-[faults.gnss_outage]
-probability = 0.3
-start_s = [10.0, 14.0]
-duration_s = [2.0, 5.0]
-
-[faults.magnetometer_step]
-probability = 0.3
-time_s = [0.5, 0.5]
-magnitude_ut = 20.0
-
-[faults.gyroscope_bias_jump]
-probability = 0.3
-time_s = [1.0, 8.0]
-magnitude_deg_s = 1.0
-
-[faults.accelerometer_bias_jump]
-probability = 0.3
-time_s = [1.0, 8.0]
-magnitude_mps2 = 0.5
-"""
-KINDS = ("stuck_canard", "slow_canard", "gnss_outage", "magnetometer_step", "gyroscope_bias_jump",
-         "accelerometer_bias_jump")  # fmt: skip
+FAULTS = EVERY_FAULT.replace("probability = 0.5", "probability = 0.3")
 DRAWS = 400
 TRUTH_ONLY_GYRO = ('[avionics]\npart = "thesis"\n', '[avionics]\npart = "thesis"\ngyroscope = { truth_only = true }\n')
 
