@@ -113,20 +113,19 @@ def anchors(page: Path) -> set[str]:
 
 def broken_links(root: Path) -> list[str]:
     """``page: target (why)`` for every relative link of ``markdown_pages`` whose file, or heading anchor in a
-    markdown file, does not exist."""
+    markdown file, does not exist. A link's text may run over lines."""
     broken = []
     for page in markdown_pages(root):
-        for line in prose_lines(page.read_text(encoding="utf-8")):
-            for target in LINK.findall(line):
-                if re.match(r"[a-z][a-z0-9+.-]*:", target, re.I):  # https:, mailto:: not relative
-                    continue
-                path, _, anchor = target.partition("#")
-                file = (page.parent / path).resolve() if path else page
-                where = f"{page.relative_to(root)}: {target}"
-                if not file.exists():
-                    broken.append(f"{where} (no such file)")
-                elif anchor and file.suffix == ".md" and anchor not in anchors(file):
-                    broken.append(f"{where} (no heading with that anchor)")
+        for target in LINK.findall("\n".join(prose_lines(page.read_text(encoding="utf-8")))):
+            if re.match(r"[a-z][a-z0-9+.-]*:", target, re.I):  # https:, mailto:: not relative
+                continue
+            path, _, anchor = target.partition("#")
+            file = (page.parent / path).resolve() if path else page
+            where = f"{page.relative_to(root)}: {target}"
+            if not file.exists():
+                broken.append(f"{where} (no such file)")
+            elif anchor and file.suffix == ".md" and anchor not in anchors(file):
+                broken.append(f"{where} (no heading with that anchor)")
     return broken
 
 
@@ -146,9 +145,9 @@ def test_the_link_check_sees_a_broken_link(tmp_path):
     # A README with a good and two broken links, a docs page with a heading: only the broken two are reported.
     (tmp_path / "docs").mkdir()
     (tmp_path / "docs" / "page.md").write_text("# A page\n\n## Some heading (`code`)\n```\n## not a heading\n```\n")
-    (tmp_path / "README.md").write_text("[ok](docs/page.md#some-heading-code) [gone](docs/none.md) "
-                                        "[fenced](docs/page.md#not-a-heading) [web](https://example.org)\n")
-    assert broken_links(tmp_path) == ["README.md: docs/none.md (no such file)",
+    (tmp_path / "README.md").write_text("[ok](docs/page.md#some-heading-code) [gone](docs/none.md) [over\ntwo "
+                                        "lines](docs/page.md#not-a-heading) [web](https://example.org)\n")
+    assert broken_links(tmp_path) == ["README.md: docs/none.md (no such file)",  # the fenced "heading" is none
                                       "README.md: docs/page.md#not-a-heading (no heading with that anchor)"]
 
 
