@@ -54,14 +54,13 @@ def unpaired_reason(baseline: Run, other: Run, names: tuple[str, str] = ("the ba
     section (``[gnc]``, ``[avionics]``) the other run does not fly at all goes with that switch, the controller or
     sensors off, and leaves the shared draws alike (each has its own stream): it does not unpair them."""
     runs = (baseline, other)
-    for what, values in (("seeds", [run.attrs.get("seed") for run in runs]), ("N", [len(run.outputs) for run in runs])):
-        if values[0] is None or values[0] != values[1]:
-            return f"{what} differ ({names[0]} {values[0]}, {names[1]} {values[1]})"
+    reasons = [f"{what} differ ({names[0]} {values[0]}, {names[1]} {values[1]})" for what, values in
+               (("seeds", [run.attrs.get("seed") for run in runs]), ("N", [len(run.outputs) for run in runs]))
+               if values[0] is None or values[0] != values[1]]  # fmt: skip
     if any("setup" not in run.attrs for run in runs):
-        return "a file does not record its campaign set-up (its dispersions)"
+        return "; ".join([*reasons, "a file does not record its campaign set-up (its dispersions)"])
     configs = [json.loads(run.attrs["setup"])["config"] for run in runs]
     drawn = [_drawn(config) for config in configs]
-    reasons = []
     for mine, theirs in ((0, 1), (1, 0)):
         flown = {section for section in SWITCHED_SECTIONS if configs[theirs][section] is not None}
         reasons += [f"{names[mine]} disperses {path}, which {names[theirs]} does not" for path in drawn[mine]
@@ -100,7 +99,8 @@ def _spec(spec: dict) -> str:
     return ", ".join(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}" for k, v in spec.items())
 
 
-def area_ratio(baseline: Run, other: Run, level: float = LEVEL, names: tuple[str, str] = ("the baseline", "the run")) -> dict:
+def area_ratio(baseline: Run, other: Run, level: float = LEVEL,
+               names: tuple[str, str] = ("the baseline", "the run")) -> dict:  # fmt: skip
     """Ratio of ``other``'s ``level`` ellipse area to ``baseline``'s and its percentile-bootstrap interval.
 
     Paired (no :func:`unpaired_reason`, the runs named ``names`` in it): the realizations landed in both runs,
