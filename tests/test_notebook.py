@@ -16,9 +16,16 @@ REPO = Path(__file__).resolve().parents[1]
 N = 64
 
 
-def test_landing_ellipses_notebook(tmp_path, monkeypatch):
-    monkeypatch.setenv("ROCKETMC_NOTEBOOK_CAMPAIGN", str(REPO / "campaigns" / "lynx_nominal.toml"))
-    monkeypatch.setenv("ROCKETMC_NOTEBOOK_N", str(N))
+N_WITHOUT_CANARDS = 16
+"""Flights per campaign of the run without canards: enough for the bootstrap and the regression's 6 inputs."""
+
+
+def _execute(tmp_path, monkeypatch, campaign: str, n: int):
+    """The notebook run top to bottom on ``campaigns/<campaign>.toml`` with N = ``n``, its results in
+    ``tmp_path/results``, then a cell printing the kernel's Python: the executed notebook and its figures (base64
+    PNGs)."""
+    monkeypatch.setenv("ROCKETMC_NOTEBOOK_CAMPAIGN", str(REPO / "campaigns" / f"{campaign}.toml"))
+    monkeypatch.setenv("ROCKETMC_NOTEBOOK_N", str(n))
     monkeypatch.setenv("ROCKETMC_NOTEBOOK_OUT", str(tmp_path / "results"))
     nb = nbformat.read(REPO / "notebooks" / "landing_ellipses.ipynb", as_version=4)
     nb.cells.append(nbformat.v4.new_code_cell("import sys\nprint(sys.executable)"))
@@ -28,6 +35,11 @@ def test_landing_ellipses_notebook(tmp_path, monkeypatch):
     assert nb.cells[-1].outputs[0]["text"].strip() == sys.executable  # the kernel is this environment's Python
     images = [output["data"]["image/png"] for cell in nb.cells for output in cell.get("outputs", [])
               if "image/png" in output.get("data", {})]  # fmt: skip
+    return nb, images
+
+
+def test_landing_ellipses_notebook(tmp_path, monkeypatch):
+    nb, images = _execute(tmp_path, monkeypatch, "lynx_nominal", N)
     assert len(images) == 4  # impacts with ellipses, the comparisons, the sensitivities, controller off and on
     assert all(len(image) > 20_000 for image in images)  # base64 PNGs with content, not empty axes
     runs = {path.name: load_run(path) for path in sorted((tmp_path / "results").glob("*.h5"))}
@@ -47,3 +59,17 @@ def test_landing_ellipses_notebook(tmp_path, monkeypatch):
     assert (on.outputs.control_active_time_s[on.ok] > 0).all()
     assert on.attrs["seed"] == off.attrs["seed"] and len(on.outputs) == len(off.outputs) == N
     pd.testing.assert_frame_equal(on.inputs, off.inputs)  # flight i drew the same inputs in both
+
+
+def test_landing_ellipses_notebook_without_canards(tmp_path, monkeypatch):
+    """A rocket without canards (campaigns/custom_rocket.toml) runs to the end: the controller's section prints why
+    it is skipped, draws and flies nothing; the three other figures and result files are there."""
+    nb, images = _execute(tmp_path, monkeypatch, "custom_rocket", N_WITHOUT_CANARDS)
+    printed = "".join(output["text"] for cell in nb.cells for output in cell.get("outputs", [])
+                      if output.get("name") == "stdout")  # fmt: skip
+    assert ("Section 5 skipped: custom_rocket cannot fly the controller (gnc: the controller steers four canards; "
+            "this rocket's aerodynamic model has 0 (rocket.geometry.canards)).\n") in printed
+    assert len(images) == 3  # impacts with ellipses, the comparisons, the sensitivities
+    names = sorted(path.name for path in (tmp_path / "results").glob("*.h5"))
+    n = N_WITHOUT_CANARDS
+    assert names == [f"custom_rocket_{variant}n{n}.h5" for variant in ("", "no_turbulence_", "simplified_")]

@@ -13,7 +13,7 @@ from matplotlib.colors import to_rgb
 from matplotlib.image import imread
 
 from rocketmc.analysis import load_run
-from rocketmc.analysis.compare import area_ratio, compare, format_comparison, is_paired
+from rocketmc.analysis.compare import area_ratio, compare, format_comparison, unpaired_reason
 from rocketmc.analysis.ellipse import bootstrap_intervals, confidence_ellipse, ellipse_area_m2
 from rocketmc.analysis.plots import plot_comparison
 from rocketmc.campaign import ResultWriter, load_campaign
@@ -32,12 +32,13 @@ def campaign():
 
 @pytest.fixture
 def write(campaign, tmp_path):
-    """``write(name, north, east, status=None, seed=1)``: a complete result file of those impacts [m]."""
+    """``write(name, north, east, status=None, seed=1, of=campaign)``: a complete result file of those impacts [m]
+    from campaign ``of``."""
 
-    def write(name, north, east, status=None, seed=1):
+    def write(name, north, east, status=None, seed=1, of=campaign):
         n = len(north)
         status = np.zeros(n, dtype=np.int32) if status is None else np.asarray(status, dtype=np.int32)
-        writer = ResultWriter(tmp_path / name, campaign.with_overrides(n_realizations=n, seed=seed), n)
+        writer = ResultWriter(tmp_path / name, of.with_overrides(n_realizations=n, seed=seed), n)
         writer.write(ChunkResult(0, {"status": status, "impact_north_m": north, "impact_east_m": east}, {}, 0.0), 0)
         return str(writer.finish())
 
@@ -90,7 +91,8 @@ def test_a_file_against_itself_is_one_exactly(write):
     path = write("a.h5", north, east, status)
     run = load_run(path)
     ratio = compare([(path, run), (path, run)])["ratios"][0]
-    assert ratio["paired"] is True and ratio["n_dropped"] == 4 and ratio["n_used"] == [N - 4, N - 4]
+    assert ratio["paired"] is True and ratio["unpaired_reason"] is None
+    assert ratio["n_dropped"] == 4 and ratio["n_used"] == [N - 4, N - 4]
     assert ratio["ratio"] == 1.0 and ratio["interval"] == [1.0, 1.0]
     assert ratio["change_pct"] == 0.0 and ratio["change_pct_interval"] == [0.0, 0.0]
 
@@ -120,12 +122,48 @@ def test_a_copy_scaled_by_a_tenth_has_a_hundredth_of_the_area(write):
     assert unpaired["change_pct_interval"] == pytest.approx([100.0 * (low - 1.0), 100.0 * (high - 1.0)], rel=1e-12)
 
 
-def test_paired_only_with_the_same_seed_and_n(write):
+def test_paired_only_with_the_same_seed_n_and_dispersions(write, campaign, capsys):
+    """Unpaired, with the reason, for another seed, another N, a dispersion one run draws and the other does not,
+    or one drawn another way; paired with the same ones. Unpaired, the comparison resamples independently (no
+    dropped flights) and the table says why."""
     north, east = _impacts()
     same = load_run(write("a.h5", north, east, seed=3))
-    assert is_paired(same, load_run(write("b.h5", north, east, seed=3)))
-    assert not is_paired(same, load_run(write("c.h5", north, east, seed=4)))
-    assert not is_paired(same, load_run(write("d.h5", north[:-1], east[:-1], seed=3)))
+    no_mass = campaign.with_overrides(values={"dispersions.rocket.dry_mass_kg": None})
+    wider = campaign.with_overrides(values={"dispersions.rocket.aero.drag_scale": {"dist": "normal", "std": 0.08}})
+    cases = {
+        "b.h5": (write("b.h5", north, east, seed=3), None),
+        "c.h5": (write("c.h5", north, east, seed=4), "seeds differ (a.h5 3, c.h5 4)"),
+        "d.h5": (write("d.h5", north[:-1], east[:-1], seed=3), f"N differ (a.h5 {N}, d.h5 {N - 1})"),
+        "e.h5": (write("e.h5", north, east, seed=3, of=no_mass), "a.h5 disperses rocket.dry_mass_kg, which e.h5 does not"),
+        "f.h5": (write("f.h5", north, east, seed=3, of=wider), "rocket.aero.drag_scale is dispersed differently "
+                 "(dist normal, std 0.05, low 0.8, high 1.2 in a.h5, dist normal, std 0.08 in f.h5)"),
+    }  # fmt: skip
+    for name, (path, reason) in cases.items():
+        assert unpaired_reason(same, load_run(path), ("a.h5", name)) == reason
+    assert unpaired_reason(load_run(cases["e.h5"][0]), same, ("e.h5", "a.h5")) == (
+        "a.h5 disperses rocket.dry_mass_kg, which e.h5 does not")
+    ratio = area_ratio(same, load_run(cases["e.h5"][0]), names=("a.h5", "e.h5"))
+    assert ratio["paired"] is False and ratio["n_dropped"] is None
+    assert ratio["unpaired_reason"] == cases["e.h5"][1]
+    paths = [str(write("a.h5", north, east, seed=3)), cases["e.h5"][0]]
+    assert main(["compare", *paths]) == 0
+    assert f"{paths[1]}: unpaired, {paths[0]} disperses rocket.dry_mass_kg, which {paths[1]} does not: the runs " \
+           "resampled independently" in capsys.readouterr().out
+
+
+def test_the_dispersions_of_a_section_switched_off_keep_the_pairing(write, campaign):
+    """A run with the controller on, its canard servos dispersed and a stuck canard drawn, against the same
+    campaign without [gnc] (``--controller off``): the switch is what is compared, every shared draw the same,
+    paired. A fault drawn in one run that both fly the section of is not."""
+    north, east = _impacts()
+    on = campaign.with_overrides(controller=True, values={
+        "dispersions.gnc.servo.time_constant_s": {"dist": "normal", "std": 0.005},
+        "faults": {"stuck_canard": {"probability": 0.1, "time_s": [1.0, 5.0]}}})  # fmt: skip
+    off, on = load_run(write("off.h5", north, east)), load_run(write("on.h5", north, east, of=on))
+    assert unpaired_reason(off, on) is None and unpaired_reason(on, off) is None
+    no_fault = load_run(write("no_fault.h5", north, east, of=campaign.with_overrides(controller=True)))
+    assert unpaired_reason(no_fault, on, ("A", "B")) == (
+        "B disperses gnc.servo.time_constant_s, which A does not; B disperses faults.stuck_canard, which A does not")
 
 
 def test_flights_failed_in_either_file_are_dropped_from_both(write):

@@ -15,6 +15,8 @@ from matplotlib.image import imread
 
 from rocketmc.analysis import Run, plot_impacts
 
+from ..conftest import CAMPAIGNS, REPO
+
 N = 500
 N_FAILED = 7  # status 1; the first 5 of them also have a NaN impact
 LEVELS = (0.5, 0.95, 0.99)
@@ -196,7 +198,7 @@ def test_launch_and_wind_of_fixed_directions_and_the_arrows_drawn():
     rail, blow = (np.asarray(a.xy) for a in arrows)  # (east, north) of each tip
     assert np.degrees(np.arctan2(*rail)) == pytest.approx(1.0) and np.degrees(np.arctan2(*blow)) == pytest.approx(-90.0)
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "mean wind 7.0 m/s from 90°\n(the arrow: where it blows to)" in legend
+    assert "wind: 2-layer wind\nmean wind 7.0 m/s from 90°\n(the arrow: where it blows to)" in legend
 
 
 def test_spread_wind_directions_give_no_wind_arrow():
@@ -214,6 +216,90 @@ def test_spread_wind_directions_give_no_wind_arrow():
     assert w["speed_mps"] == pytest.approx(speed)
     ax = plot_impacts(run).axes[0]
     assert len([a for a in ax.texts if getattr(a, "arrow_patch", None) is not None]) == 1  # the rail only
-    assert any(t.get_text().startswith(f"mean wind speed {speed:.1f} m/s, its direction\nspread")
+    assert any(t.get_text().startswith(f"wind: constant wind\nmean wind speed {speed:.1f} m/s, its direction\nspread")
                for t in ax.get_legend().get_texts())  # fmt: skip
     assert launch_and_wind(_run()) is None  # a file without setup: nothing drawn
+
+
+def _with_campaign(run, name, inputs, apogee_m=3000.0):
+    """``run`` as flown from ``campaigns/<name>.toml`` (its resolved set-up, file digests and all), with ``inputs``
+    and every flight's apogee ``apogee_m`` [m]."""
+    import json
+
+    from rocketmc.campaign import load_campaign
+    from rocketmc.campaign.fingerprint import setup
+
+    outputs = run.outputs.assign(apogee_agl_m=apogee_m)
+    return Run(outputs, pd.DataFrame(inputs, index=outputs.index),
+               {**run.attrs, "setup": json.dumps(setup(load_campaign(CAMPAIGNS / f"{name}.toml")))}, run.units,
+               run.status_codes)  # fmt: skip
+
+
+def _weather_wind(name, heights_m):
+    """(north, east) [m/s] of the day's wind of data/weather/``name`` at EuRoC's site, ``heights_m`` above the pad,
+    the components interpolated between its levels (as the flights' ``WindProfile``)."""
+    from datetime import datetime, timezone
+
+    from rocketmc.env.weather import geometric_altitude, read_weather
+
+    time = datetime(2023, 10, 13, 12, tzinfo=timezone.utc) if name.endswith(".nc") else None
+    w = read_weather(REPO / "src" / "rocketmc" / "data" / "weather" / name, 39.3903, -8.2892, time)
+    altitude = geometric_altitude(w.geopotential_height_m) - 160.0
+    return (np.interp(heights_m, altitude, -w.speed_mps * np.cos(w.from_rad)),
+            np.interp(heights_m, altitude, -w.speed_mps * np.sin(w.from_rad)))  # fmt: skip
+
+
+@pytest.mark.parametrize("campaign, file, source", [
+    ("lynx_euroc_era5", "euroc_2023_all_windows.nc", "ERA5/GFS profile of 2023-10-13 12:00Z (euroc_2023_all_windows.nc)"),
+    ("lynx_euroc_sounding", "euroc_2023-10-13_12z_era5_uwyo.txt", "sounding (euroc_2023-10-13_12z_era5_uwyo.txt)"),
+])  # fmt: skip
+def test_the_days_wind_is_described_and_drawn_not_calm(campaign, file, source):
+    """An ERA5 or sounding campaign (its [environment.wind] the schema's calm default): the label names the profile
+    and gives its 10 m wind; the mean wind over the heights from the pad to the apogee, turned and scaled per
+    flight as drawn, is the arrow. Every flight turned by 30° and scaled by 2: the mean turns by 30° and doubles,
+    the 10 m wind (nominal) stays."""
+    from rocketmc.analysis.plots import PROFILE_HEIGHTS, launch_and_wind
+
+    north, east = _weather_wind(file, np.linspace(0.0, 3000.0, PROFILE_HEIGHTS))
+    speed = np.hypot(north, east)
+    north_10, east_10 = _weather_wind(file, 10.0)
+    surface = (np.hypot(north_10, east_10), np.degrees(np.arctan2(-east_10, -north_10)) % 360.0)
+    base = _with_campaign(_run(), campaign, {})
+    turned = _with_campaign(_run(), campaign, {"environment.atmosphere.wind_rotation_deg": np.full(N, 30.0),
+                                               "environment.atmosphere.wind_scale": np.full(N, 2.0)})  # fmt: skip
+    found, found_turned = launch_and_wind(base), launch_and_wind(turned)
+    w, w_turned = found["wind"], found_turned["wind"]
+    assert found["source"] == source
+    assert w["speed_mps"] == pytest.approx(speed.mean(), rel=1e-12) and w["speed_mps"] > 5.0
+    assert (w["north_mps"], w["east_mps"]) == pytest.approx((north.mean(), east.mean()), rel=1e-12)
+    assert w["surface"] == pytest.approx(surface, rel=1e-12) and w_turned["surface"] == w["surface"]
+    assert w_turned["speed_mps"] == pytest.approx(2.0 * w["speed_mps"], rel=1e-12)
+    assert (w_turned["from_deg"] - w["from_deg"]) % 360.0 == pytest.approx(30.0, rel=1e-9)
+    legend = [t.get_text() for t in plot_impacts(turned).axes[0].get_legend().get_texts()]
+    (note,) = [text for text in legend if text.startswith("wind: ")]
+    assert note == (f"wind: {source}:\n{surface[0]:.1f} m/s from {surface[1]:.0f}° at 10 m\n"
+                    f"mean wind to apogee {w_turned['speed_mps']:.1f} m/s from {w_turned['from_deg']:.0f}°\n"
+                    "(the arrow: where it blows to)")  # fmt: skip
+    assert "calm" not in note
+
+
+def test_a_measured_profile_and_a_profile_not_at_hand():
+    """The Roccaraso campaign's measured profile (data/wind, its speed scale dispersed): named, with the range of
+    the scales drawn; the same run whose set-up names another file's digest (a user's file, not here): named, not
+    drawn."""
+    import json
+
+    from rocketmc.analysis.plots import launch_and_wind
+
+    run = _with_campaign(_run(), "lynx_roccaraso_2021", {"environment.wind.speed_scale": np.linspace(0.5, 1.5, N)})
+    found = launch_and_wind(run)
+    assert found["source"] == "measured profile (roccaraso_2021.csv)" and found["wind"]["scaled"] == (0.5, 1.5)
+    legend = [t.get_text() for t in plot_impacts(run).axes[0].get_legend().get_texts()]
+    assert any(text.startswith("wind: measured profile (roccaraso_2021.csv):\n") and
+               f"\nscaled ×0.50…1.50 over the {N} flights\n" in text for text in legend)  # fmt: skip
+    setup = json.loads(run.attrs["setup"])
+    setup["files"]["environment.wind.file"] = "0" * 64
+    other = Run(run.outputs, run.inputs, {**run.attrs, "setup": json.dumps(setup)}, run.units, run.status_codes)
+    assert launch_and_wind(other)["wind"] is None
+    legend = [t.get_text() for t in plot_impacts(other).axes[0].get_legend().get_texts()]
+    assert "wind: measured profile (roccaraso_2021.csv),\nits file not at hand here: not drawn" in legend

@@ -1,15 +1,18 @@
 """Landing dispersion of several runs against the first (the baseline): each run's 95 % impact ellipse
 with bootstrap intervals of its area and centre (as ``report``), and the ratio of each area to the
 baseline's with a percentile-bootstrap interval, paired when realization i met the same draws in both
-runs (the same seed and N, docs/conventions.md, Randomness), else resampling the runs independently.
-Impact points are north/east [m] from the pad; intervals are 95 % ones."""
+runs (:func:`unpaired_reason`: the same seed and N, and the same dispersions; docs/conventions.md,
+Randomness), else resampling the runs independently. Impact points are north/east [m] from the pad;
+intervals are 95 % ones."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Sequence
 
 import numpy as np
 
+from ..campaign.config import FAULT_SECTIONS
 from ..errors import RocketmcError
 from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
 from .results import Run, _table, navigation_warnings
@@ -40,20 +43,72 @@ def dispersion(run: Run, level: float = LEVEL) -> dict:
     }
 
 
-def is_paired(baseline: Run, other: Run) -> bool:
-    """Whether realization i of both runs drew the same dispersions and turbulence: same seed and N."""
-    seed = baseline.attrs.get("seed")
-    return seed is not None and seed == other.attrs.get("seed") and len(baseline.outputs) == len(other.outputs)
+SHOWN_PATHS = 3
+"""Dispersions an unpaired reason names before 'and n more'."""
 
 
-def area_ratio(baseline: Run, other: Run, level: float = LEVEL) -> dict:
+def unpaired_reason(baseline: Run, other: Run, names: tuple[str, str] = ("the baseline", "the run")) -> str | None:
+    """None where realization i of both runs drew the same random inputs (pairing them flight by flight makes
+    sense), else why not, naming the runs ``names``: another seed or N, or dispersions (``[dispersions]``, the
+    faults drawn) that one run draws and the other does not, or draws another way. A dispersion or fault of a
+    section (``[gnc]``, ``[avionics]``) the other run does not fly at all goes with that switch, the controller or
+    sensors off, and leaves the shared draws alike (each has its own stream): it does not unpair them."""
+    runs = (baseline, other)
+    reasons = [f"{what} differ ({names[0]} {values[0]}, {names[1]} {values[1]})" for what, values in
+               (("seeds", [run.attrs.get("seed") for run in runs]), ("N", [len(run.outputs) for run in runs]))
+               if values[0] is None or values[0] != values[1]]  # fmt: skip
+    if any("setup" not in run.attrs for run in runs):
+        return "; ".join([*reasons, "a file does not record its campaign set-up (its dispersions)"])
+    configs = [json.loads(run.attrs["setup"])["config"] for run in runs]
+    drawn = [_drawn(config) for config in configs]
+    for mine, theirs in ((0, 1), (1, 0)):
+        flown = {section for section in SWITCHED_SECTIONS if configs[theirs][section] is not None}
+        reasons += [f"{names[mine]} disperses {path}, which {names[theirs]} does not" for path in drawn[mine]
+                    if path not in drawn[theirs] and _section(path) not in SWITCHED_SECTIONS - flown]  # fmt: skip
+    reasons += [f"{path} is dispersed differently ({_spec(drawn[0][path])} in {names[0]}, {_spec(drawn[1][path])} in "
+                f"{names[1]})" for path in drawn[0] if path in drawn[1] and drawn[0][path] != drawn[1][path]]  # fmt: skip
+    if not reasons:
+        return None
+    more = len(reasons) - SHOWN_REASONS
+    return "; ".join(reasons[:SHOWN_REASONS]) + (f"; and {more} more" if more > 0 else "")
+
+
+SHOWN_REASONS = 3
+"""Differing dispersions an unpaired reason names before 'and n more'."""
+SWITCHED_SECTIONS = {"gnc", "avionics"}
+"""Sections a run may fly or not (``--controller``, ``--sensors``): their dispersions and faults go with them."""
+
+
+def _drawn(config: dict) -> dict[str, dict]:
+    """What a resolved campaign config (a file's ``setup``) draws per flight: each dispersion's settings by its
+    path, each fault some flight can have by ``faults.<fault>``."""
+    drawn = {path: {k: v for k, v in spec.items() if v is not None} for path, spec in config["dispersions"].items()}
+    faults = config.get("faults") or {}
+    drawn.update({f"faults.{name}": f for name, f in faults.items() if f is not None and f["probability"] > 0.0})
+    return drawn
+
+
+def _section(path: str) -> str:
+    """The campaign section a drawn ``path`` acts on: its first part, a fault's ``FAULT_SECTIONS``."""
+    first, _, rest = path.partition(".")
+    return FAULT_SECTIONS[rest] if first == "faults" else first
+
+
+def _spec(spec: dict) -> str:
+    """A dispersion's settings in words: ``normal std 0.18, high 90``."""
+    return ", ".join(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}" for k, v in spec.items())
+
+
+def area_ratio(baseline: Run, other: Run, level: float = LEVEL,
+               names: tuple[str, str] = ("the baseline", "the run")) -> dict:  # fmt: skip
     """Ratio of ``other``'s ``level`` ellipse area to ``baseline``'s and its percentile-bootstrap interval.
 
-    Paired (:func:`is_paired`): the realizations landed in both runs, the others (``n_dropped``) dropped
-    from both, resampled with the same indices in both; unpaired: each run's ok flights, resampled
-    independently (``n_dropped`` None). Keys ``paired, n_used, n_dropped, ratio, interval`` and the
-    relative change (ratio − 1) [%] ``change_pct, change_pct_interval``."""
-    paired = is_paired(baseline, other)
+    Paired (no :func:`unpaired_reason`, the runs named ``names`` in it): the realizations landed in both runs,
+    the others (``n_dropped``) dropped from both, resampled with the same indices in both; unpaired: each run's
+    ok flights, resampled independently (``n_dropped`` None). Keys ``paired, unpaired_reason, n_used, n_dropped,
+    ratio, interval`` and the relative change (ratio − 1) [%] ``change_pct, change_pct_interval``."""
+    reason = unpaired_reason(baseline, other, names)
+    paired = reason is None
     kept = baseline.landed & other.landed if paired else None
     samples = (np.stack(baseline.ok_impacts(kept)), np.stack(other.ok_impacts(kept)))
     _enough(min(s.shape[1] for s in samples), "flight(s) landed in both runs" if paired else "ok flight(s)")
@@ -67,6 +122,7 @@ def area_ratio(baseline: Run, other: Run, level: float = LEVEL) -> dict:
     interval = percentile_interval(samples, ratio, paired)
     return {
         "paired": paired,
+        "unpaired_reason": reason,
         "n_used": [s.shape[1] for s in samples],
         "n_dropped": int(kept.size - kept.sum()) if paired else None,
         "ratio": value,
@@ -86,7 +142,7 @@ def compare(runs: Sequence[tuple[str, Run]], level: float = LEVEL) -> dict:
         "warnings": [f"{file}: {line}" for file, run in runs for line in navigation_warnings(run)],
         "runs": [{"file": file, **_naming(file, dispersion, run, level)} for file, run in runs],
         "ratios": [{"file": file, "baseline": base_file,
-                    **_naming(f"{file} against {base_file}", area_ratio, baseline, run, level)}
+                    **_naming(f"{file} against {base_file}", area_ratio, baseline, run, level, (base_file, file))}
                    for file, run in others],  # fmt: skip
     }
 
@@ -137,5 +193,7 @@ def format_comparison(comparison: dict) -> str:
             ],  # fmt: skip
             align="llrrrr",
         )
+        out += [f"{r['file']}: unpaired, {r['unpaired_reason']}: the runs resampled independently"
+                for r in comparison["ratios"] if not r["paired"]]  # fmt: skip
     out += [f"Warning: {line}" for line in comparison["warnings"]]
     return "\n".join(out)

@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from pathlib import Path
-
+import hashlib
 import json
+from collections.abc import Sequence
+from datetime import datetime
+from importlib import resources
+from pathlib import Path
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from ..env.weather import geometric_altitude, read_weather
+from ..env.wind import read_wind_profile
 from ..files import replacing
 from .ellipse import Ellipse, confidence_ellipse
 from .results import Run
@@ -29,20 +33,30 @@ def _shorten(text: str, width: int = 40) -> str:
 SPREAD_RESULTANT = 0.5
 """Below this ratio of the mean wind vector's length to the mean wind speed the directions are called spread
 (0 for directions drawn uniformly over 360°, 1 for one fixed direction): no wind arrow is drawn then."""
+PROFILE_HEIGHTS = 100
+"""Heights, evenly spaced from the pad to the ok flights' median apogee, over which a profile's wind is averaged."""
+SURFACE_HEIGHT_M = 10.0
+"""The height above the pad [m] a profile's surface wind is given at (the meteorological 10 m wind)."""
 
 
 def launch_and_wind(run: Run) -> dict | None:
-    """The rail azimuth and the mean wind from the file's ``setup`` attribute (its resolved campaign), each
+    """The rail azimuth and the wind flown from the file's ``setup`` attribute (its resolved campaign), each
     value taken per flight from ``/inputs`` where dispersed; None for a file without ``setup``.
 
-    ``{"azimuth_deg": circular mean rail azimuth [deg clockwise from north], "wind": None (a profile
-    file) or {"speed_mps": mean wind speed [m/s], "north_mps", "east_mps": the vector mean of the wind
-    blowing towards [m/s], "from_deg": the direction the vector mean blows from, "resultant": its length
-    over the mean speed, "spread": resultant < SPREAD_RESULTANT}}``. Over the flights and the wind layers
-    (each layer weighted alike; ``constant`` and ``power_law`` winds at their reference height)."""
+    ``{"azimuth_deg": circular mean rail azimuth [deg clockwise from north], "source": what wind was flown, in
+    words ("3-layer wind", "ERA5/GFS profile of 2023-10-13 12:00Z (file.nc)", "sounding (file.txt)", "measured
+    profile (file.csv)"), "wind": None (a profile whose file is not at hand: not the package's own, or changed) or
+    {"speed_mps": mean wind speed [m/s], "north_mps", "east_mps": the vector mean of the wind blowing towards
+    [m/s], "from_deg": the direction the vector mean blows from, "resultant": its length over the mean speed,
+    "spread": resultant < SPREAD_RESULTANT, and for a profile "surface": (speed [m/s], from [deg]) of its nominal
+    wind at SURFACE_HEIGHT_M, "turned_deg", "scaled": (lowest, highest) of the turns [deg] and scales [-] drawn per
+    flight, "flights": how many}}``. Over the flights and the wind layers (each layer weighted alike; ``constant``
+    and ``power_law`` winds at their reference height; a profile over PROFILE_HEIGHTS heights from the pad to the
+    median apogee)."""
     if "setup" not in run.attrs:
         return None
-    config = json.loads(run.attrs["setup"])["config"]
+    setup = json.loads(run.attrs["setup"])
+    config = setup["config"]
 
     def drawn(name, default):
         """The values of ``name`` per flight: its /inputs column where dispersed, else ``default``."""
@@ -54,52 +68,126 @@ def launch_and_wind(run: Run) -> dict | None:
         return float(np.mean(lengths * np.cos(radians))), float(np.mean(lengths * np.sin(radians)))
 
     azimuth_north, azimuth_east = resultant(drawn("launch.azimuth_deg", config["launch"]["azimuth_deg"]), 1.0)
-    wind = config["environment"]["wind"]
-    if wind["model"] == "layers":
+    result = {"azimuth_deg": float(np.degrees(np.arctan2(azimuth_east, azimuth_north)) % 360.0), "wind": None}
+    wind, atmosphere = config["environment"]["wind"], config["environment"].get("atmosphere")
+    extra = {}
+    if atmosphere is not None or wind["model"] == "profile":
+        found = _profile(config, setup.get("files", {}))
+        result["source"] = found[0]
+        if found[1] is None:
+            return result
+        altitude_m, north_mps, east_mps = found[1]
+        if atmosphere is not None:
+            turned = drawn("environment.atmosphere.wind_rotation_deg", atmosphere["wind_rotation_deg"])
+            scaled = drawn("environment.atmosphere.wind_scale", atmosphere["wind_scale"])
+        else:
+            turned, scaled = np.zeros(len(run.outputs)), drawn("environment.wind.speed_scale", wind["speed_scale"])
+        apogee = run.outputs["apogee_agl_m"].to_numpy(float)[run.ok] if "apogee_agl_m" in run.outputs else []
+        top = float(np.nanmedian(apogee)) if np.isfinite(apogee).any() else float(altitude_m[-1])
+        heights = np.linspace(0.0, max(top, 0.0), PROFILE_HEIGHTS)
+        at_speed, at_from = _speed_from(*(np.interp(heights, altitude_m, c) for c in (north_mps, east_mps)))
+        layers = [(scaled * at_speed[j], at_from[j] + turned) for j in range(heights.size)]  # height j in every flight
+        surface = _speed_from(*(np.interp(SURFACE_HEIGHT_M, altitude_m, c) for c in (north_mps, east_mps)))
+        extra = {"surface": tuple(map(float, surface)), "flights": int(turned.size),
+                 "turned_deg": (float(turned.min()), float(turned.max())),
+                 "scaled": (float(scaled.min()), float(scaled.max()))}  # fmt: skip
+    elif wind["model"] == "layers":
+        result["source"] = f"{len(wind['layers'])}-layer wind"
         names = [f"environment.wind.layers.{k}." for k in range(len(wind["layers"]))]
         layers = [(drawn(f"{n}speed_mps", layer["speed_mps"]), drawn(f"{n}from_deg", layer["from_deg"]))
                   for n, layer in zip(names, wind["layers"])]  # fmt: skip
-    elif wind["model"] == "profile":
-        layers = []
     else:
+        result["source"] = ("constant wind" if wind["model"] == "constant"
+                            else f"power-law wind, at {wind['reference_height_m']:g} m")  # fmt: skip
         layers = [(drawn("environment.wind.speed_mps", wind["speed_mps"]),
                    drawn("environment.wind.from_deg", wind["from_deg"]))]  # fmt: skip
-    result = {"azimuth_deg": float(np.degrees(np.arctan2(azimuth_east, azimuth_north)) % 360.0), "wind": None}
-    if layers:
-        speed, from_deg = (np.concatenate(values) for values in zip(*layers))
-        north, east = resultant(from_deg + 180.0, speed)
-        mean_speed = float(speed.mean())
-        ratio = float(np.hypot(north, east) / mean_speed) if mean_speed > 0 else 0.0
-        result["wind"] = {"speed_mps": mean_speed, "north_mps": north, "east_mps": east, "resultant": ratio,
-                          "from_deg": float(np.degrees(np.arctan2(-east, -north)) % 360.0),
-                          "spread": ratio < SPREAD_RESULTANT}  # fmt: skip
+    speed, from_deg = (np.concatenate(values) for values in zip(*layers))
+    north, east = resultant(from_deg + 180.0, speed)
+    mean_speed = float(speed.mean())
+    ratio = float(np.hypot(north, east) / mean_speed) if mean_speed > 0 else 0.0
+    result["wind"] = {"speed_mps": mean_speed, "north_mps": north, "east_mps": east, "resultant": ratio,
+                      "from_deg": float(np.degrees(np.arctan2(-east, -north)) % 360.0),
+                      "spread": ratio < SPREAD_RESULTANT, **extra}  # fmt: skip
     return result
 
 
+def _speed_from(north_mps, east_mps):
+    """Speed [m/s] and the direction it blows from [deg clockwise from north, 0-360] of a wind (north, east)."""
+    return np.hypot(north_mps, east_mps), np.degrees(np.arctan2(-east_mps, -north_mps)) % 360.0
+
+
+def _profile(config: dict, digests: dict) -> tuple[str, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
+    """What profile wind a resolved campaign ``config`` flew, in words, and its nominal wind: (altitude above the
+    pad [m], north, east [m/s]) at its levels, read from the package's data file of that name if it is the one
+    flown (its SHA-256 among the set-up's file ``digests``), else None (a user's file, not at hand here)."""
+    atmosphere, site = config["environment"].get("atmosphere"), config["site"]
+    field, folder = ("environment.atmosphere.file", "weather") if atmosphere else ("environment.wind.file", "wind")
+    name = atmosphere["file"] if atmosphere else config["environment"]["wind"]["file"]
+    path = resources.files("rocketmc") / "data" / folder / name
+    flown = path.is_file() and hashlib.sha256(path.read_bytes()).hexdigest() == digests.get(field)
+    if not atmosphere:
+        source = f"measured profile ({name})"
+        if not flown:
+            return source, None
+        altitude, speed, from_rad = read_wind_profile(path, site["altitude_m"])
+    else:
+        time = atmosphere["time_utc"]
+        source = f"sounding ({name})" if time is None else f"ERA5/GFS profile ({name})"
+        if not flown:
+            return source, None
+        weather = read_weather(path, site["latitude_deg"], site["longitude_deg"],
+                               None if time is None else datetime.fromisoformat(time), atmosphere["grid"])  # fmt: skip
+        if weather.time_utc is not None:
+            source = f"ERA5/GFS profile of {weather.time_utc:%Y-%m-%d %H:%M}Z ({name})"
+        altitude = geometric_altitude(weather.geopotential_height_m) - site["altitude_m"]
+        speed, from_rad = weather.speed_mps, weather.from_rad
+    return source, (altitude, -speed * np.cos(from_rad), -speed * np.sin(from_rad))
+
+
+def _wind_note(found: dict) -> str:
+    """The legend's line on the wind flown (``launch_and_wind``)."""
+    wind, source = found["wind"], found["source"]
+    if wind is None:
+        return f"wind: {source},\nits file not at hand here: not drawn"
+    lines = [f"wind: {source}" + (":" if "surface" in wind else "")]
+    if "surface" in wind:
+        (low_turn, high_turn), (low_scale, high_scale) = wind["turned_deg"], wind["scaled"]
+        surface = wind["surface"]
+        lines.append(f"{surface[0]:.1f} m/s from {surface[1]:.0f}° at {SURFACE_HEIGHT_M:g} m")
+        varied = [text for text, low, high in ((f"turned {low_turn:+.0f}…{high_turn:+.0f}°", low_turn, high_turn),
+                                                (f"scaled ×{low_scale:.2f}…{high_scale:.2f}", low_scale, high_scale))
+                  if low != high]  # fmt: skip
+        if varied:
+            lines.append(f"{', '.join(varied)} over the {wind['flights']} flights")
+    if wind["speed_mps"] == 0.0:
+        lines.append("calm: no wind")
+    elif wind["spread"]:
+        lines.append(f"mean wind speed {wind['speed_mps']:.1f} m/s, its direction\nspread over the flights (vector "
+                     f"mean {wind['resultant'] * wind['speed_mps']:.1f} m/s): no arrow")  # fmt: skip
+    else:
+        over = " to apogee" if "surface" in wind else ""
+        lines.append(f"mean wind{over} {wind['speed_mps']:.1f} m/s from {wind['from_deg']:.0f}°\n(the arrow: where "
+                     "it blows to)")  # fmt: skip
+    return "\n".join(lines)
+
+
 def _draw_launch_and_wind(ax: Axes, run: Run, length_m: float) -> None:
-    """The rail azimuth and the mean wind (where it blows to) as arrows of ``length_m`` [m] from the pad; the
-    mean wind speed in words when the directions are spread (see :data:`SPREAD_RESULTANT`)."""
+    """The rail azimuth and the mean wind (where it blows to) as arrows of ``length_m`` [m] from the pad, and what
+    wind was flown in words (``_wind_note``; no wind arrow when the directions are spread, see
+    :data:`SPREAD_RESULTANT`)."""
     found = launch_and_wind(run)
     if found is None:
         return
     arrows = [("tab:gray", found["azimuth_deg"], f"rail {found['azimuth_deg']:.0f}°")]
     wind = found["wind"]
-    if wind is None:
-        note = "wind: from a profile file, not drawn"
-    elif wind["speed_mps"] == 0.0:
-        note = "calm: no wind"
-    elif wind["spread"]:
-        note = (f"mean wind speed {wind['speed_mps']:.1f} m/s, its direction\nspread over the flights (vector mean "
-                f"{wind['resultant'] * wind['speed_mps']:.1f} m/s): no arrow")  # fmt: skip
-    else:
-        note = f"mean wind {wind['speed_mps']:.1f} m/s from {wind['from_deg']:.0f}°\n(the arrow: where it blows to)"
+    if wind is not None and wind["speed_mps"] > 0.0 and not wind["spread"]:
         arrows.append(("tab:cyan", (wind["from_deg"] + 180.0) % 360.0, f"wind from {wind['from_deg']:.0f}°"))
     for color, towards_deg, label in arrows:
         tip = (length_m * np.sin(np.radians(towards_deg)), length_m * np.cos(np.radians(towards_deg)))  # (east, north)
         ax.annotate("", xy=tip, xytext=(0.0, 0.0), arrowprops={"arrowstyle": "-|>", "color": color, "linewidth": 2.0},
                     zorder=6)  # fmt: skip
         ax.annotate(label, xy=tip, xytext=(3, 3), textcoords="offset points", color=color, fontsize="small", zorder=6)
-    ax.plot([], [], color=arrows[-1][0] if len(arrows) > 1 else "none", linewidth=2.0, label=note)  # a legend line
+    ax.plot([], [], color=arrows[-1][0] if len(arrows) > 1 else "none", linewidth=2.0, label=_wind_note(found))
 
 
 def _area_label(area_m2: float) -> str:
