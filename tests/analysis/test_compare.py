@@ -16,7 +16,7 @@ from rocketmc.analysis import load_run
 from rocketmc.analysis.compare import area_ratio, compare, format_comparison, is_paired
 from rocketmc.analysis.ellipse import bootstrap_intervals, confidence_ellipse, ellipse_area_m2
 from rocketmc.analysis.plots import plot_comparison
-from rocketmc.campaign import ResultWriter, load_campaign
+from rocketmc.campaign import ResultWriter, load_campaign, with_overrides
 from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
@@ -37,7 +37,7 @@ def write(campaign, tmp_path):
     def write(name, north, east, status=None, seed=1):
         n = len(north)
         status = np.zeros(n, dtype=np.int32) if status is None else np.asarray(status, dtype=np.int32)
-        writer = ResultWriter(tmp_path / name, campaign.with_overrides(n_realizations=n, seed=seed), n)
+        writer = ResultWriter(tmp_path / name, with_overrides(campaign, n_realizations=n, seed=seed), n)
         writer.write(ChunkResult(0, {"status": status, "impact_north_m": north, "impact_east_m": east}, {}, 0.0), 0)
         return str(writer.finish())
 
@@ -236,7 +236,7 @@ def test_diverged_navigation_is_counted_and_warned(write, tmp_path, capsys):
     north, east = _impacts()
     a = write("a.h5", north, east)
     b = str(tmp_path / "b.h5")
-    writer = ResultWriter(b, load_campaign(CAMPAIGNS / "lynx_ballistic.toml").with_overrides(n_realizations=N, seed=1), N)
+    writer = ResultWriter(b, with_overrides(load_campaign(CAMPAIGNS / "lynx_ballistic.toml"), n_realizations=N, seed=1), N)
     flag = np.zeros(N)
     flag[:5] = 1.0
     outputs = {"status": np.zeros(N, dtype=np.int32), "impact_north_m": north, "impact_east_m": east, DIVERGED: flag}

@@ -8,7 +8,8 @@ import jax
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import ConfigError, GncConfig, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign.schema import GncConfig
 from rocketmc.campaign.model import nominal_params
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"

@@ -16,18 +16,9 @@ from hypothesis import strategies as st
 
 from rocketmc.aero.io import lynx_datcom_tables, save_aero_tables
 from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign
-from rocketmc.campaign.config import (
-    MAX_NAME_LENGTH,
-    MAX_REALIZATIONS,
-    MIN_CONTROL_DT_S,
-    MIN_MASS_KG,
-    NORMAL_REACH_STD,
-    GncConfig,
-    GuidanceConfig,
-    ServoConfig,
-    flatten_numbers,
-    preset_rocket,
-)
+from rocketmc.campaign.limits import MAX_NAME_LENGTH, MAX_REALIZATIONS, MIN_CONTROL_DT_S, MIN_MASS_KG, NORMAL_REACH_STD
+from rocketmc.campaign.loader import flatten_numbers, preset_rocket
+from rocketmc.campaign.schema import GncConfig, GuidanceConfig, ServoConfig
 from rocketmc.cli import main
 
 ROOT = Path(__file__).parents[2]
