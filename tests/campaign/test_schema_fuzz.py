@@ -425,6 +425,7 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "gnc.guidance.apogee_m"),  # derived: the nominal flight does not climb after 60 s
         ("[dispersions]", '[gnc]\n\n[dispersions]\n"gnc.guidance.apogee_m" = { dist = "normal", std = 10.0 }',
          "dispersions.gnc.guidance.apogee_m"),
+        ("rail_length_m = 4.0", "rail_lenght_m = 4.0", "launch.rail_lenght_m"),  # the misspelling, not the missing key
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
          "long-name", "binary-thrust-file", "binary-aero-csv", "elevation-above-90", "negative-mass", "missing-n",
@@ -440,7 +441,8 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "hard-iron-spread-draws-out-of-range", "soft-iron-spread-draws-out-of-range",
          "misalignment-spread-draws-out-of-range", "soft-iron-spread-dispersed", "unknown-filter-field-model",
          "pad-samples-not-whole", "pad-time-against-dispersed-ignition", "pad-samples-dispersed", "apogee-zero",
-         "flight-path-angle-nan", "roll-heading-text", "derived-apogee-after-the-climb", "apogee-dispersed"],
+         "flight-path-angle-nan", "roll-heading-text", "derived-apogee-after-the-climb", "apogee-dispersed",
+         "misspelt-required-key"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old
