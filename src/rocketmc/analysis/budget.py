@@ -10,11 +10,12 @@ other rows, the navigation and control metrics of ``sim/flight.py`` (medians and
 flights.
 
 A source is an entry of ``SOURCES``: a name, a description, the config overrides that switch it off (dotted path
--> value, applied by ``campaign.loader.with_overrides(campaign, values=...)``) and why switching it off would change nothing in a
-campaign (its sensor is not read, or it has no error already); such a source is reported, not flown. A sensor's
-errors are switched off by its ``truth_only``; the reference field's (``field_model``) by giving the filters the
-truth's model and zeroing the truth's anomaly, its dispersions removed. Each row is flown with
-``campaign.run_chunks`` (one compilation per row: a sensor's ``truth_only`` is a static switch).
+-> value, applied by ``with_overrides(campaign, values=...)``, the campaign loaded again with them) and why switching
+it off would change nothing in a campaign (its sensor is not read, or it has no error already); such a source is
+reported, not flown. A sensor's errors are switched off by its ``truth_only``; the reference field's
+(``field_model``) by giving the filters the truth's model and zeroing the truth's anomaly, its dispersions removed.
+Each row is flown with ``campaign.run_chunks`` (one compilation per row: a sensor's ``truth_only`` is a static
+switch).
 """
 
 from __future__ import annotations

@@ -59,15 +59,16 @@ def with_overrides(
     controller: bool | None = None, sensors: bool | None = None, navigation: str | None = None,
     values: Mapping[str, object] | None = None,
 ) -> Campaign:  # fmt: skip
-    """``campaign`` loaded again (``campaign_from_dict``: every check run, the gains designed again) from its config
-    with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
-    True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
-    and its faults (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
-    (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
-    campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
-    perfect navigation (their faults removed too); navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
-    values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above, and
-    dispersions by their parameter's path after ``dispersions.``: a table sets one, None removes it."""
+    """``campaign`` loaded again by the one builder (``campaign_from_dict``: every check run, the gains designed
+    again) from its validated tables with the overrides applied: N, the seed and/or the aerodynamic model replaced
+    (CLI options); controller: True adds a [gnc] section of defaults if there is none, False removes it and its
+    servo dispersions and its faults (the same flights with the canards neutral); sensors: True adds an [avionics]
+    section of defaults (the thesis's parts) if there is none and flies the controller on raw sensors (or on its
+    filters, if the campaign's navigation is "filters"), False removes it and its dispersions and flies the
+    controller on perfect navigation (their faults removed too); navigation: the controller's ("truth", "sensors"
+    or "filters"), with sensors to match; values: fields set by dotted path (``{"avionics.gyroscope.truth_only":
+    True}``), after the options above, and dispersions by their parameter's path after ``dispersions.``: a table
+    sets one, None removes it. The result file's campaign text stays the file's."""
     if navigation is not None:
         sensors = navigation != "truth"
     data = campaign.config.model_dump()
