@@ -22,7 +22,7 @@ import jax
 import numpy as np
 
 from rocketmc.bench import seconds_per_flight
-from rocketmc.campaign import load_campaign
+from rocketmc.campaign import load_campaign, with_overrides
 from rocketmc.campaign.runner import batch_size, compile_chunk
 
 MODELS = ("interpolated", "simplified", "linear")
@@ -41,7 +41,7 @@ def main() -> int:
     batch = batch_size(args.n)
     compiled, compile_s = {}, {}
     for model in MODELS:
-        campaign = base.with_overrides(n_realizations=args.n, aero_model=model)
+        campaign = with_overrides(base, n_realizations=args.n, aero_model=model)
         t0 = time.perf_counter()
         compiled[model] = compile_chunk(campaign, batch)
         compile_s[model] = time.perf_counter() - t0

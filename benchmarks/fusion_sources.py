@@ -27,7 +27,7 @@ import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 from kernel_profile import computations, fused_sizes, fusion_calls  # noqa: E402
 
-from rocketmc.campaign import load_campaign  # noqa: E402
+from rocketmc.campaign import load_campaign, with_overrides  # noqa: E402
 from rocketmc.campaign.runner import GROUP, realization_params, sim_settings  # noqa: E402
 from rocketmc.sim import flight  # noqa: E402
 
@@ -84,7 +84,7 @@ def main() -> None:
     parser.add_argument("--top", type=int, default=30)
     args = parser.parse_args()
 
-    campaign = load_campaign(args.campaign).with_overrides(aero_model="simplified")
+    campaign = with_overrides(load_campaign(args.campaign), aero_model="simplified")
     settings, master_key = sim_settings(campaign), jax.random.key(campaign.config.seed)
 
     def params(index):

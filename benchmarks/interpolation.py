@@ -21,7 +21,7 @@ from jax.scipy.interpolate import RegularGridInterpolator
 
 import rocketmc.aero.model
 from rocketmc.aero.datcom import LYNX_DATCOM, load_datcom_mat
-from rocketmc.campaign import load_campaign
+from rocketmc.campaign import load_campaign, with_overrides
 from rocketmc.campaign.runner import compile_chunk
 from rocketmc.math.table import interpolate
 
@@ -46,7 +46,7 @@ def reference_lookup(table, point):
 
 
 def campaign_flights_per_s(n: int, repeats: int) -> float:
-    campaign = load_campaign("campaigns/lynx_nominal.toml").with_overrides(n_realizations=n, aero_model="interpolated")
+    campaign = with_overrides(load_campaign("campaigns/lynx_nominal.toml"), n_realizations=n, aero_model="interpolated")
     compiled = compile_chunk(campaign, n)
     key, indices = jax.random.key(0), np.arange(n, dtype=np.uint32)
     return n / best_time(compiled, (key, indices), repeats)

@@ -27,7 +27,7 @@ import time  # noqa: E402
 import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 
-from rocketmc.campaign import load_campaign  # noqa: E402
+from rocketmc.campaign import load_campaign, with_overrides  # noqa: E402
 from rocketmc.campaign.runner import realization_params, sim_settings  # noqa: E402
 from rocketmc.sim import flight  # noqa: E402
 
@@ -62,7 +62,7 @@ def main() -> None:
     parser.add_argument("--top", type=int, default=25)
     args = parser.parse_args()
 
-    campaign = load_campaign(args.campaign).with_overrides(n_realizations=args.lanes, aero_model=args.aero_model)
+    campaign = with_overrides(load_campaign(args.campaign), n_realizations=args.lanes, aero_model=args.aero_model)
     settings = sim_settings(campaign)
     master_key = jax.random.key(campaign.config.seed)
 

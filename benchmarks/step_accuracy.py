@@ -11,7 +11,7 @@ import dataclasses
 
 import numpy as np
 
-from rocketmc.campaign import load_campaign, run_chunks
+from rocketmc.campaign import load_campaign, run_chunks, with_overrides
 
 
 def outputs(campaign) -> dict:
@@ -24,7 +24,7 @@ def main() -> None:
     parser.add_argument("--campaign", default="campaigns/lynx_nominal.toml")
     parser.add_argument("--n", type=int, default=200)
     args = parser.parse_args()
-    campaign = load_campaign(args.campaign).with_overrides(n_realizations=args.n)
+    campaign = with_overrides(load_campaign(args.campaign), n_realizations=args.n)
     sim = campaign.config.simulation
     fine_sim = sim.model_copy(update={"substeps": 4 * sim.substeps, "descent_dt_s": sim.control_dt_s})
     fine = dataclasses.replace(campaign, config=campaign.config.model_copy(update={"simulation": fine_sim}))

@@ -27,7 +27,7 @@ def pytest_configure(config):
 @pytest.fixture(scope="session")
 def lynx_campaign():
     """The Lynx campaign (drogue + main, three-layer wind, dispersions)."""
-    from rocketmc.campaign.config import load_campaign
+    from rocketmc.campaign import load_campaign
 
     return load_campaign(CAMPAIGNS / "lynx_nominal.toml")
 

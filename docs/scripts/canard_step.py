@@ -17,7 +17,7 @@ import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
 
-from rocketmc.campaign import load_campaign
+from rocketmc.campaign import load_campaign, with_overrides
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.aero.canards import allocate
@@ -36,7 +36,7 @@ def calm(p):
 
 
 def response(campaign, model: str, step: bool) -> dict[str, np.ndarray]:
-    c = campaign.with_overrides(aero_model=model)
+    c = with_overrides(campaign, aero_model=model)
     p = calm(nominal_params(c))
     settings = sim_settings(c)
     n_periods = int(round(DURATION_S / settings.control_dt_s))

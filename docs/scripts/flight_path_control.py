@@ -19,7 +19,7 @@ import jax
 import matplotlib.pyplot as plt
 import numpy as np
 
-from rocketmc.campaign.config import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict, with_overrides
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.gnc.guidance import reference_direction
@@ -38,7 +38,7 @@ def steady_wind_campaign(path: Path, aero_model: str | None):
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": WIND_MPS, "from_deg": raw["launch"]["azimuth_deg"]}}
     raw["dispersions"] = {}
     campaign = campaign_from_dict(raw, path.parent, path.read_text())
-    return campaign if aero_model is None else campaign.with_overrides(aero_model=aero_model)
+    return campaign if aero_model is None else with_overrides(campaign, aero_model=aero_model)
 
 
 def flight(campaign) -> dict[str, np.ndarray]:

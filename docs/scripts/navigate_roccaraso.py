@@ -41,7 +41,7 @@ from rocketmc.analysis import replay
 from rocketmc.analysis.flight_log import ROCCARASO_2021, load_roccaraso_2021, read_pitot_static, reduce_flight
 from rocketmc.analysis.sensor_log import high_frequency_noise, read_sensor_log
 from rocketmc.campaign import load_campaign
-from rocketmc.campaign.config import PositionFilterConfig
+from rocketmc.campaign.schema import PositionFilterConfig
 from rocketmc.campaign.model import filter_params
 from rocketmc.env.atmosphere import pressure_height_m
 from rocketmc.math import Vec3

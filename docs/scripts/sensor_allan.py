@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rocketmc.analysis.allan import allan_deviation, noise_terms, plot_allan
-from rocketmc.campaign.config import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict
 from rocketmc.campaign.sensor_record import sensor_record
 
 ROOT = Path(__file__).parents[2]

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import jax
 
-from rocketmc.campaign.config import load_campaign
+from rocketmc.campaign import load_campaign
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.sim.flight import simulate_one

@@ -37,7 +37,7 @@ import numpy as np
 
 from . import PRECISION
 from .analysis.ellipse import confidence_ellipse
-from .campaign import load_campaign, run_chunks
+from .campaign import load_campaign, run_chunks, with_overrides
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings
 from .sim.flight import Status
 
@@ -98,7 +98,7 @@ def ratios(campaign, repeats: int = 3) -> dict:
     """The batch-against-loop ratio on ``campaign``, simplified model, on every core: seconds per flight [s] of
     ``LOOP_FLIGHTS`` single flights in a loop and of a vmapped batch (``_batch``), timed together
     (``_timed_together``); ``loop_over_batch``."""
-    simplified = campaign.with_overrides(aero_model="simplified")
+    simplified = with_overrides(campaign, aero_model="simplified")
     batch = _batch()
     s = _timed_together(campaign, {
         "loop": (single_flights, (simplified,), LOOP_FLIGHTS),
@@ -116,15 +116,15 @@ def costs(campaign, repeats: int = 3) -> dict:
     (the closed loop on the navigation filters). Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
     work a flight takes, and on one thread the best rounds of a function agree within ~5 % where the
     two-core rounds, whose threads wait on each other, spread ~10 % (measured on the 2-core VM)."""
-    open_loop = campaign.with_overrides(aero_model="simplified", controller=False, sensors=False)
-    closed_loop = open_loop.with_overrides(controller=True)
+    open_loop = with_overrides(campaign, aero_model="simplified", controller=False, sensors=False)
+    closed_loop = with_overrides(open_loop, controller=True)
     batch = _batch()
     s = _timed_together(campaign, {
         "simplified": (compile_chunk, (open_loop, batch), batch),
-        "interpolated": (compile_chunk, (open_loop.with_overrides(aero_model="interpolated"), batch), batch),
+        "interpolated": (compile_chunk, (with_overrides(open_loop, aero_model="interpolated"), batch), batch),
         "closed_loop": (compile_chunk, (closed_loop, batch), batch),
-        "sensors": (compile_chunk, (closed_loop.with_overrides(sensors=True), batch), batch),
-        "filters": (compile_chunk, (closed_loop.with_overrides(navigation="filters"), batch), batch),
+        "sensors": (compile_chunk, (with_overrides(closed_loop, sensors=True), batch), batch),
+        "filters": (compile_chunk, (with_overrides(closed_loop, navigation="filters"), batch), batch),
     }, repeats)  # fmt: skip
     return {"batch": batch, "s_per_flight": s, "interpolated_over_simplified": s["interpolated"] / s["simplified"],
             "closed_over_open_loop": s["closed_loop"] / s["simplified"],
@@ -178,7 +178,7 @@ def _measure(spec: dict) -> dict:
     if spec["kind"] in TIMED_TOGETHER:
         result = TIMED_TOGETHER[spec["kind"]](campaign, spec["repeats"])
     else:
-        campaign = campaign.with_overrides(n_realizations=spec["n"], aero_model=spec["model"])
+        campaign = with_overrides(campaign, n_realizations=spec["n"], aero_model=spec["model"])
         with float32_draws() if spec["float32_draws"] else contextlib.nullcontext():
             result = throughput(campaign, spec["chunk_size"], spec["impacts"])
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # kB on Linux, bytes on macOS
@@ -286,7 +286,7 @@ def run_benchmarks(
     path = str(Path(campaign).resolve())
     base = load_campaign(path)
     for model in dict.fromkeys((*models, *MODELS)):  # the ratios fly both MODELS
-        base.with_overrides(aero_model=model)  # a model the campaign cannot fly fails here
+        with_overrides(base, aero_model=model)  # a model the campaign cannot fly fails here
     report = {"campaign": base.config.name, "campaign_file": path, "machine": machine(), "measurements": []}
     compared = (min(sizes), models[0]) if set(PRECISIONS) <= set(precisions) else None
     with tempfile.TemporaryDirectory() as tmp:

@@ -260,10 +260,10 @@ def _refuse_existing(option: str, path: Path, force: bool) -> Path:
 def _campaign(path, **overrides):
     """The campaign file ``path`` with the CLI's overrides (N, seed, aerodynamic model, controller); an error
     names the file."""
-    from .campaign import ConfigError, load_campaign
+    from .campaign import ConfigError, load_campaign, with_overrides
 
     try:
-        return load_campaign(path).with_overrides(**overrides)
+        return with_overrides(load_campaign(path), **overrides)
     except ConfigError as e:
         raise RocketmcError(f"{path}: {e}") from None
 
@@ -339,7 +339,7 @@ def _gnc_design(args) -> int:
     campaign = _campaign(args.campaign, aero_model=args.aero_model)
     if campaign.gnc_schedule is None:
         raise RocketmcError(f"{args.campaign}: no [gnc] section, so no gains to design")
-    summary = schedule_summary(campaign)
+    summary = schedule_summary(campaign.config, campaign.gnc_schedule, campaign.gnc_inputs)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -401,7 +401,7 @@ def _navigate(args) -> int:
     from .analysis import replay as nav_replay
     from .analysis.flight_log import read_pitot_static
     from .analysis.sensor_log import read_sensor_log
-    from .campaign.config import FiltersConfig
+    from .campaign.schema import FiltersConfig
     from .campaign.model import filter_params
     from .files import replacing
 

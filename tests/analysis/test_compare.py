@@ -16,7 +16,7 @@ from rocketmc.analysis import load_run
 from rocketmc.analysis.compare import area_ratio, compare, format_comparison, unpaired_reason
 from rocketmc.analysis.ellipse import bootstrap_intervals, confidence_ellipse, ellipse_area_m2
 from rocketmc.analysis.plots import plot_comparison
-from rocketmc.campaign import ResultWriter, load_campaign
+from rocketmc.campaign import ResultWriter, load_campaign, with_overrides
 from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
@@ -38,7 +38,7 @@ def write(campaign, tmp_path):
     def write(name, north, east, status=None, seed=1, of=campaign):
         n = len(north)
         status = np.zeros(n, dtype=np.int32) if status is None else np.asarray(status, dtype=np.int32)
-        writer = ResultWriter(tmp_path / name, of.with_overrides(n_realizations=n, seed=seed), n)
+        writer = ResultWriter(tmp_path / name, with_overrides(of, n_realizations=n, seed=seed), n)
         writer.write(ChunkResult(0, {"status": status, "impact_north_m": north, "impact_east_m": east}, {}, 0.0), 0)
         return str(writer.finish())
 
@@ -128,8 +128,8 @@ def test_paired_only_with_the_same_seed_n_and_dispersions(write, campaign, capsy
     dropped flights) and the table says why."""
     north, east = _impacts()
     same = load_run(write("a.h5", north, east, seed=3))
-    no_mass = campaign.with_overrides(values={"dispersions.rocket.dry_mass_kg": None})
-    wider = campaign.with_overrides(values={"dispersions.rocket.aero.drag_scale": {"dist": "normal", "std": 0.08}})
+    no_mass = with_overrides(campaign, values={"dispersions.rocket.dry_mass_kg": None})
+    wider = with_overrides(campaign, values={"dispersions.rocket.aero.drag_scale": {"dist": "normal", "std": 0.08}})
     cases = {
         "b.h5": (write("b.h5", north, east, seed=3), None),
         "c.h5": (write("c.h5", north, east, seed=4), "seeds differ (a.h5 3, c.h5 4)"),
@@ -156,12 +156,12 @@ def test_the_dispersions_of_a_section_switched_off_keep_the_pairing(write, campa
     campaign without [gnc] (``--controller off``): the switch is what is compared, every shared draw the same,
     paired. A fault drawn in one run that both fly the section of is not."""
     north, east = _impacts()
-    on = campaign.with_overrides(controller=True, values={
+    on = with_overrides(campaign, controller=True, values={
         "dispersions.gnc.servo.time_constant_s": {"dist": "normal", "std": 0.005},
         "faults": {"stuck_canard": {"probability": 0.1, "time_s": [1.0, 5.0]}}})  # fmt: skip
     off, on = load_run(write("off.h5", north, east)), load_run(write("on.h5", north, east, of=on))
     assert unpaired_reason(off, on) is None and unpaired_reason(on, off) is None
-    no_fault = load_run(write("no_fault.h5", north, east, of=campaign.with_overrides(controller=True)))
+    no_fault = load_run(write("no_fault.h5", north, east, of=with_overrides(campaign, controller=True)))
     assert unpaired_reason(no_fault, on, ("A", "B")) == (
         "B disperses gnc.servo.time_constant_s, which A does not; B disperses faults.stuck_canard, which A does not")
 
@@ -274,7 +274,7 @@ def test_diverged_navigation_is_counted_and_warned(write, tmp_path, capsys):
     north, east = _impacts()
     a = write("a.h5", north, east)
     b = str(tmp_path / "b.h5")
-    writer = ResultWriter(b, load_campaign(CAMPAIGNS / "lynx_ballistic.toml").with_overrides(n_realizations=N, seed=1), N)
+    writer = ResultWriter(b, with_overrides(load_campaign(CAMPAIGNS / "lynx_ballistic.toml"), n_realizations=N, seed=1), N)
     flag = np.zeros(N)
     flag[:5] = 1.0
     outputs = {"status": np.zeros(N, dtype=np.int32), "impact_north_m": north, "impact_east_m": east, DIVERGED: flag}

@@ -11,7 +11,7 @@ from rocketmc.aero import AirData
 from rocketmc.aero.model import linear_derivatives, simplify
 from rocketmc.aero.stability import centre_of_pressure_at
 from rocketmc.analysis.flight_record import energy_balance, flight_record
-from rocketmc.campaign import load_campaign, run_chunks
+from rocketmc.campaign import load_campaign, run_chunks, with_overrides
 from rocketmc.campaign.model import nominal_params
 from rocketmc.env import G0
 
@@ -21,7 +21,7 @@ N, REALIZATION = 16, 11
 
 @pytest.fixture(scope="module")
 def campaign():
-    return load_campaign(CAMPAIGNS / "lynx_nominal.toml").with_overrides(n_realizations=N)
+    return with_overrides(load_campaign(CAMPAIGNS / "lynx_nominal.toml"), n_realizations=N)
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +75,7 @@ def test_static_margin_against_the_model(campaign, record):
 
 def test_centre_of_pressure_of_the_linear_model(campaign):
     # docs/lynx.md's linear model: CNα 24.0744, Cmα −37.2959 per rad about the reference point, d = 0.15 m
-    aero = nominal_params(campaign.with_overrides(aero_model="linear")).rocket.aero
+    aero = nominal_params(with_overrides(campaign, aero_model="linear")).rocket.aero
     air = AirData(*(jnp.asarray(x) for x in (100.0, 0.0, 0.0, 0.3, 6000.0, 1.1, 1500.0)))
     x_cp = float(centre_of_pressure_at(aero, air, jnp.asarray(0.0)))
     assert x_cp == pytest.approx(-37.2959 / 24.0744 * 0.15, rel=1e-9)  # linear in α: the slope is exact

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rocketmc.campaign import load_campaign, run_chunks
+from rocketmc.campaign import load_campaign, run_chunks, with_overrides
 from rocketmc.cli import main
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
@@ -40,7 +40,7 @@ def test_dispersed_roccaraso_brackets_the_measured_apogee():
     """The Roccaraso campaign with the uncertainties a team would assume before the flight (mass 1 %,
     impulse 3 %, drag 5 %, rail angles, wind ±50 %) holds the measured 1419 m inside its 95 % interval.
     96 flights: the 2.5 and 97.5 percentiles move by ~20 m between seeds, against a 260 m wide interval."""
-    campaign = load_campaign(CAMPAIGNS / "lynx_roccaraso_2021.toml").with_overrides(n_realizations=96)
+    campaign = with_overrides(load_campaign(CAMPAIGNS / "lynx_roccaraso_2021.toml"), n_realizations=96)
     chunks = list(run_chunks(campaign, 96))[1:]
     outputs = chunks[0].outputs
     assert np.all(outputs["status"] == 0)

@@ -8,7 +8,8 @@ import jax
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import ConfigError, GncConfig, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign.schema import GncConfig
 from rocketmc.campaign.model import nominal_params
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
@@ -176,10 +177,14 @@ def test_preset_and_override():
         (edited("values = [0.0, 1.0, 2.0, 3.0]", "values = [0.0, 1.0, 2.0, 5.0]"), "dispersions.environment.turbulence.severity", "out of range"),
         (edited("[environment.turbulence]", '[environment.wind]\nexponent = 0.2\n\n[environment.turbulence]'), "environment.wind", "'exponent' does not apply to the 'layers' wind model"),
         (edited('preset = "lynx"', 'preset = "lynx"\nairbrakes = { time_s = [0.0, 4.0], delta_ca = [0.0, 0.5, 0.2] }'), "rocket.airbrakes", "same length"),
+        (edited("rail_length_m = 4.0", "rail_lenght_m = 4.0"), "launch.rail_lenght_m", "unknown key (did you mean 'rail_length_m'?)"),
+        (edited("rail_length_m = 4.0", "rail_length = 4.0"), "launch.rail_length", "unknown key (did you mean 'rail_length_m'?)"),
+        (edited("rail_length_m = 4.0", "xyz = 4.0"), "launch.rail_length_m", "missing (required)"),
     ],
     ids=["missing", "wrong-type", "unknown-key", "negative-mass", "elevation>90", "negative-wind", "preset",
          "thrust-file", "isp", "dispersion-path", "dispersion-range", "dispersion-params", "dispersion-kind", "toml",
-         "severity", "severity-draw", "wind-key", "airbrakes"],
+         "severity", "severity-draw", "wind-key", "airbrakes", "misspelt-required-key", "required-key-without-unit",
+         "unknown-key-beside-a-missing-one"],
 )  # fmt: skip
 def test_bad_input_names_the_field(text, field, words):
     with pytest.raises(ConfigError) as info:

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 import rocketmc.campaign
-from rocketmc.campaign import ResultWriter, load_campaign
+from rocketmc.campaign import ResultWriter, load_campaign, with_overrides
 from rocketmc.campaign import distributed as dask_runner
 from rocketmc.campaign.fingerprint import fingerprint, setup
 from rocketmc.campaign.runner import ChunkResult
@@ -70,7 +70,7 @@ def test_two_workers_write_the_local_bits(tmp_path, monkeypatch, faulted):
         assert got_attrs["campaign_toml"] == want_attrs["campaign_toml"]
         assert list(got_attrs["completed_chunks"]) == list(range(N // CHUNK))
 
-        campaign = load_campaign(faulted).with_overrides(n_realizations=N, seed=SEED)
+        campaign = with_overrides(load_campaign(faulted), n_realizations=N, seed=SEED)
         resumes(address, faulted, campaign, want, tmp_path / "resumed.h5")
         stops_early(client, campaign)
         refuses_workers_unlike_the_client(client, campaign)

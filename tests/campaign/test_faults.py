@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 from rocketmc.analysis import format_summary, load_run, summarize
-from rocketmc.campaign import parse_campaign
-from rocketmc.campaign.config import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict, parse_campaign, with_overrides
 from rocketmc.campaign.runner import realization_params
 from rocketmc.campaign.sampling import realization_key, sample_faults
 from rocketmc.cli import main
@@ -92,14 +91,14 @@ def test_controller_or_sensors_off_remove_their_faults():
     """``--controller off`` flies the canards neutral: the servos' faults go with [gnc]; ``--sensors off`` removes
     the sensors' faults."""
     campaign = faulted()
-    assert set(campaign.with_overrides(controller=False).config.faults.active()) == set(KINDS[2:])
-    assert set(campaign.with_overrides(sensors=False).config.faults.active()) == set(KINDS[:2])
+    assert set(with_overrides(campaign, controller=False).config.faults.active()) == set(KINDS[2:])
+    assert set(with_overrides(campaign, sensors=False).config.faults.active()) == set(KINDS[:2])
 
 
 @pytest.fixture(scope="module")
 def chunks():
     """lynx_ballistic_gnc_1s with every fault at 0.3, 24 flights in chunks of 5 and of 20."""
-    campaign = faulted().with_overrides(n_realizations=24)
+    campaign = with_overrides(faulted(), n_realizations=24)
     return collect(campaign, 5), collect(campaign, 20)
 
 

@@ -16,11 +16,12 @@ import numpy as np
 import pytest
 
 from rocketmc.aero.canards import allocate
-from rocketmc.campaign import campaign_from_dict
-from rocketmc.campaign.config import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS, ConfigError, preset_rocket
+from rocketmc.campaign import ConfigError, campaign_from_dict, with_overrides
+from rocketmc.campaign.limits import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS
+from rocketmc.campaign.loader import preset_rocket
 from rocketmc.campaign.fingerprint import data_digest
-from rocketmc.campaign.gains import design_inputs, plant_point
-from rocketmc.campaign.model import nominal_params
+from rocketmc.campaign.gains import plant_point
+from rocketmc.campaign.model import airframe_params, nominal_params
 from rocketmc.gnc.design import (
     THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, flown_loop, lqi_gain, lqi_plant,
 )  # fmt: skip
@@ -50,7 +51,7 @@ def linear():
 @pytest.fixture(scope="module")
 def simplified(linear):
     """Designed anew by ``with_overrides`` (the CLI's --aero-model): simplify of the build-up tables, ~7 s."""
-    return linear.with_overrides(aero_model="simplified")
+    return with_overrides(linear, aero_model="simplified")
 
 
 def test_linear_schedule_is_the_thesis_plant_at_burnout(linear):
@@ -123,7 +124,12 @@ def test_interpolated_designs_on_its_own_linearisation(simplified):
 
 
 def test_overrides_keep_or_redesign_the_gains(linear, simplified):
-    assert linear.with_overrides(n_realizations=5, seed=1).gnc_schedule is linear.gnc_schedule
+    """Overrides are loaded again, the gains designed again: the same bits where the design's inputs are the same,
+    others where the rocket changes."""
+    kept = with_overrides(linear, n_realizations=5, seed=1).gnc_schedule
+    np.testing.assert_array_equal(kept.gains, linear.gnc_schedule.gains)
+    heavier = with_overrides(linear, values={"rocket.dry_mass_kg": linear.config.rocket.dry_mass_kg + 1.0})
+    assert not np.array_equal(heavier.gnc_schedule.gains, linear.gnc_schedule.gains)
     # The build-up's derivatives are not the thesis's (Cmα, Cm_δ differ by tens of %): other gains.
     assert np.abs(simplified.gnc_schedule.gains - linear.gnc_schedule.gains).max() > 0.01
 
@@ -136,7 +142,7 @@ def test_without_gnc_nothing_is_designed():
 def test_controller_and_sensors_added_at_once():
     """``with_overrides(controller=True, sensors=True)`` on a campaign with neither: the default [gnc] (its
     navigation the schema's "truth" until the sensors come) flies on raw sensors, designed."""
-    campaign = campaign_from_dict(NOMINAL, CAMPAIGNS).with_overrides(controller=True, sensors=True)
+    campaign = with_overrides(campaign_from_dict(NOMINAL, CAMPAIGNS), controller=True, sensors=True)
     assert campaign.config.gnc.navigation == "sensors" and campaign.config.avionics is not None
     assert campaign.gnc_schedule is not None
 
@@ -146,11 +152,12 @@ def shifted_rate_jacobian(raw: dict, speed: float, height: float):
     of the flight's own right-hand side ``sim.flight.derivatives``) at axial speed [m/s] and height above
     the pad [m], coasting (after burnout) in calm air; columns v, w, p, q, r, u_y, u_p, u_r."""
     campaign = campaign_from_dict({**raw, "environment": {}, "dispersions": {}}, CAMPAIGNS)  # no wind
-    inputs = design_inputs(campaign)
+    inputs = campaign.gnc_inputs
     point = plant_point(inputs.aero, inputs.mass, speed, SITE_M + height, inputs.omega_a)
     a_plant = lqi_plant(point)[0][:5]
 
-    params = nominal_params(dataclasses.replace(campaign, config=campaign.config.model_copy(update={"gnc": None})))
+    params = airframe_params(campaign.config, campaign.thrust_time_s, campaign.thrust_n, campaign.aero,
+                             campaign.wind_profile, campaign.weather, campaign.nominal)  # fmt: skip
     motor = params.rocket.motor
     t = motor.ignition_time_s + motor.burn_time_s + 1.0
     events = dataclasses.replace(initial_state(params).events, rail_exit_time=jnp.zeros(()))  # off the rail
@@ -197,7 +204,7 @@ def test_window_estimate_of_lynx(linear):
     """The point-mass estimate the grid check uses, on Lynx (1-10 s after liftoff): the 6-DOF flight
     (calm, linear model) measured 62.0-183.3 m/s and 31-1224 m above the pad there. The estimate has
     no rotation and starts the CG at the pad (it starts ~1 m up the rail): within 1 % and 5 m."""
-    inputs = design_inputs(linear)
+    inputs = linear.gnc_inputs
     np.testing.assert_allclose(inputs.speeds, (62.0, 183.3), rtol=0.01)
     np.testing.assert_allclose(inputs.altitudes_agl, (31.2, 1223.6), atol=5.0)
 

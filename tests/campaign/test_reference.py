@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import tomllib
 
-from rocketmc.campaign.config import fixed_reason
+from rocketmc.campaign.limits import fixed_reason
 from rocketmc.campaign.reference import INDEX, reference, rows, unit
 
 from ..conftest import CAMPAIGNS, REPO

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rocketmc.campaign import parse_campaign, run_chunks
+from rocketmc.campaign import parse_campaign, run_chunks, with_overrides
 
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 
@@ -53,7 +53,7 @@ def test_same_bits_for_any_chunk_size(name, sensors):
     text = path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if closed_loop else "[dispersions]\n")
     if sensors:
         text = text.replace('navigation = "truth"', 'navigation = "sensors"').replace("[dispersions]", SENSORS + "[dispersions]")
-    campaign = parse_campaign(text, path.parent).with_overrides(n_realizations=24)
+    campaign = with_overrides(parse_campaign(text, path.parent), n_realizations=24)
     a_out, a_in = collect(campaign, 5)
     b_out, b_in = collect(campaign, 20)
     assert a_out.keys() == b_out.keys() and a_in.keys() == b_in.keys()

@@ -16,18 +16,9 @@ from hypothesis import strategies as st
 
 from rocketmc.aero.io import lynx_datcom_tables, save_aero_tables
 from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign
-from rocketmc.campaign.config import (
-    MAX_NAME_LENGTH,
-    MAX_REALIZATIONS,
-    MIN_CONTROL_DT_S,
-    MIN_MASS_KG,
-    NORMAL_REACH_STD,
-    GncConfig,
-    GuidanceConfig,
-    ServoConfig,
-    flatten_numbers,
-    preset_rocket,
-)
+from rocketmc.campaign.limits import MAX_NAME_LENGTH, MAX_REALIZATIONS, MIN_CONTROL_DT_S, MIN_MASS_KG, NORMAL_REACH_STD
+from rocketmc.campaign.loader import flatten_numbers, preset_rocket
+from rocketmc.campaign.schema import GncConfig, GuidanceConfig, ServoConfig
 from rocketmc.cli import main
 
 ROOT = Path(__file__).parents[2]
@@ -434,6 +425,7 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "gnc.guidance.apogee_m"),  # derived: the nominal flight does not climb after 60 s
         ("[dispersions]", '[gnc]\n\n[dispersions]\n"gnc.guidance.apogee_m" = { dist = "normal", std = 10.0 }',
          "dispersions.gnc.guidance.apogee_m"),
+        ("rail_length_m = 4.0", "rail_lenght_m = 4.0", "launch.rail_lenght_m"),  # the misspelling, not the missing key
     ],
     ids=["inf-wind", "nan-thrust-scale", "inf-ignition", "inf-max-time", "clip-excludes-nominal", "newline-name",
          "long-name", "binary-thrust-file", "binary-aero-csv", "elevation-above-90", "negative-mass", "missing-n",
@@ -449,7 +441,8 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
          "hard-iron-spread-draws-out-of-range", "soft-iron-spread-draws-out-of-range",
          "misalignment-spread-draws-out-of-range", "soft-iron-spread-dispersed", "unknown-filter-field-model",
          "pad-samples-not-whole", "pad-time-against-dispersed-ignition", "pad-samples-dispersed", "apogee-zero",
-         "flight-path-angle-nan", "roll-heading-text", "derived-apogee-after-the-climb", "apogee-dispersed"],
+         "flight-path-angle-nan", "roll-heading-text", "derived-apogee-after-the-climb", "apogee-dispersed",
+         "misspelt-required-key"],
 )  # fmt: skip
 def test_cli_run_refuses_with_one_line_and_writes_nothing(tmp_path, capsys, old, new, field):
     assert old in NOMINAL, old

@@ -23,7 +23,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rocketmc.campaign import ResultWriter, load_campaign, run_chunks
+from rocketmc.campaign import ResultWriter, load_campaign, run_chunks, with_overrides
 from rocketmc.campaign.runner import ChunkResult
 from rocketmc.cli import main
 
@@ -51,7 +51,7 @@ def flown(tmp_path_factory):
     campaign_file = _campaign_dir(root / "campaign")
     reference = root / "reference.h5"
     assert main(["run", str(campaign_file), *ARGS, "--out", str(reference)]) == 0
-    campaign = load_campaign(campaign_file).with_overrides(n_realizations=24)
+    campaign = with_overrides(load_campaign(campaign_file), n_realizations=24)
     partial_out = root / "partial.h5"
     writer = ResultWriter(partial_out, campaign, 8)
     runs = run_chunks(campaign, 8)
@@ -151,7 +151,7 @@ def test_a_chunk_of_another_set_up_is_refused(case, capsys, tmp_path):
     partial = Path(f"{out}.partial")
     with h5py.File(partial / "chunk_000001.h5") as f:
         rows = ChunkResult(8, *({k: v[()] for k, v in f[g].items()} for g in ("outputs", "inputs")), 0.0)
-    other = ResultWriter(tmp_path / "other.h5", load_campaign(campaign).with_overrides(n_realizations=24, seed=99), 8)
+    other = ResultWriter(tmp_path / "other.h5", with_overrides(load_campaign(campaign), n_realizations=24, seed=99), 8)
     other.write(rows, 1)
     shutil.copy(tmp_path / "other.h5.partial" / "chunk_000001.h5", partial / "chunk_000001.h5")
     resume_refused(capsys, campaign, out, "chunk_000001.h5", "another set-up")
@@ -291,7 +291,7 @@ def test_the_gather_checks_the_chunks_again(flown, tmp_path):
     writes no result file."""
     campaign_file, partial, _ = flown
     shutil.copytree(partial, tmp_path / "run.h5.partial")
-    campaign = load_campaign(campaign_file).with_overrides(n_realizations=24)
+    campaign = with_overrides(load_campaign(campaign_file), n_realizations=24)
     writer = ResultWriter(tmp_path / "run.h5", campaign, 8, resume=True)
     chunk = tmp_path / "run.h5.partial" / "chunk_000002.h5"
     chunk.write_bytes(chunk.read_bytes()[:-50])

@@ -17,7 +17,7 @@ from rocketmc.analysis import format_summary, load_outputs, load_run, load_traje
 from rocketmc.analysis import flight_record as flight_record_module
 from rocketmc.analysis.ellipse import AreaConvergence
 from rocketmc.analysis.flight_record import flight_record
-from rocketmc.campaign import load_campaign
+from rocketmc.campaign import load_campaign, with_overrides
 from rocketmc.cli import main
 from rocketmc.env import G0
 
@@ -40,7 +40,7 @@ def campaign_file(tmp_path_factory):
 @pytest.fixture(scope="module")
 def campaign(campaign_file):
     """The campaign as ``run`` flies it: the same set-up, so ``flight_record`` reuses the run's compiled flight."""
-    return load_campaign(campaign_file).with_overrides(n_realizations=N, seed=SEED)
+    return with_overrides(load_campaign(campaign_file), n_realizations=N, seed=SEED)
 
 
 @pytest.fixture(scope="module")

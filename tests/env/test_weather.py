@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import scipy.io
 
-from rocketmc.campaign.config import load_campaign
+from rocketmc.campaign import load_campaign
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.cli import main

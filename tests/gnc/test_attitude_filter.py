@@ -8,6 +8,8 @@ Error convention under test: q_true = q̂ ⊗ exp(δϑ), δϑ in the estimate's 
 
 from __future__ import annotations
 
+import dataclasses
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -17,6 +19,8 @@ import scipy.stats
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
+from rocketmc.campaign.model import attitude_tuning
+from rocketmc.campaign.schema import AttitudeFilterConfig
 from rocketmc.gnc import navigation  # noqa: F401  (navigation imports the filter: the package's import order)
 from rocketmc.gnc.attitude_filter import (
     SERIES_BELOW,
@@ -36,7 +40,8 @@ from rocketmc.gnc.attitude_filter import (
 from rocketmc.math.vectors import Quat, Vec3
 
 T = 0.02
-THESIS = AttitudeTuning()
+THESIS = attitude_tuning(AttitudeFilterConfig())
+"""The thesis's tuning (docs/gnc.md §2): the schema's defaults."""
 FIELD_N = Vec3(0.478, -0.107, 0.872)  # the dipole's unit field at Roccaraso (docs/gnc.md §2), NED
 
 
@@ -97,7 +102,7 @@ def van_loan(omega, dt, sigma_v, sigma_u):
 # (0, 1): the σ_u terms alone, which the thesis's σ_v hides at T = 0.02 s
 @pytest.mark.parametrize("sigmas", [(THESIS.gyro_noise, THESIS.bias_walk), (0.0, 1.0)])
 def test_error_model_matches_expm_and_van_loan(omega, dt, sigmas):
-    tuning = AttitudeTuning(gyro_noise=sigmas[0], bias_walk=sigmas[1])
+    tuning = dataclasses.replace(THESIS, gyro_noise=sigmas[0], bias_walk=sigmas[1])
     phi, q = error_transition(vec(omega), dt, tuning)
     phi_ref, q_ref = van_loan(np.array(omega), dt, *sigmas)
     # expm's own error grows with ‖F T‖ (up to 25 here: ~2e-13); the closed forms and series are ~1e-14.
@@ -146,7 +151,7 @@ def test_quaternion_propagation_matches_ode_solution():
 
 def test_update_matches_kalman_equations_and_joseph_equals_standard_form():
     rng = np.random.default_rng(4)
-    tuning = AttitudeTuning(field_direction_std=0.05)
+    tuning = dataclasses.replace(THESIS, field_direction_std=0.05)
     for seed in range(5):
         p = random_covariance(rng)
         q = quat(Rotation.random(random_state=10 + seed))
@@ -176,7 +181,7 @@ def test_covariance_stays_symmetric_positive_definite_with_a_sharp_magnetometer(
     """σ_b = 2e-4, the thesis magnetometer's own noise (10 nT on ~47 µT), from P0 = I: S's condition number
     reaches ~1e7 and the attitude variance across the field falls by 8 orders in one update; 150 ticks of a
     spinning truth keep P exactly symmetric with its eigenvalues positive."""
-    tuning = AttitudeTuning(gyro_noise=1e-3, bias_walk=1e-4, field_direction_std=2e-4)
+    tuning = dataclasses.replace(THESIS, gyro_noise=1e-3, bias_walk=1e-4, field_direction_std=2e-4)
     rate = Vec3(1.0, 0.5, -0.3)
     q_true = quat(Rotation.random(random_state=5))
 
@@ -198,7 +203,7 @@ def test_perfect_measurement_pulls_estimate_toward_truth():
     h shrinks by σ²/(p + σ²) (the scalar Kalman factor), the component along h (unobservable) is unchanged,
     the bias untouched (P21 = 0 gives K2 = 0)."""
     p_att, sigma = 1e-2, 1e-2
-    tuning = AttitudeTuning(field_direction_std=sigma, initial_attitude_std=np.sqrt(p_att), initial_bias_std=0.01)
+    tuning = dataclasses.replace(THESIS, field_direction_std=sigma, initial_attitude_std=np.sqrt(p_att), initial_bias_std=0.01)
     q_true = quat(Rotation.random(random_state=6))
     error = np.array([2e-4, -3e-4, 1e-4])  # small: second-order terms ~1e-7 rad
     q_hat = q_true * rotation_step(vec(-error), 1.0)
@@ -399,7 +404,7 @@ def test_gradient_through_filter_steps_is_finite_and_matches_finite_difference()
     q0 = quat(Rotation.random(random_state=11))
 
     def loss(rate_x, field_std):
-        tuning = AttitudeTuning(field_direction_std=field_std)
+        tuning = dataclasses.replace(THESIS, field_direction_std=field_std)
         est = initial_attitude(q0, tuning)
         for k in range(2):
             est = magnetometer_update(est, Vec3(0.3, -0.1 - 0.1 * k, 0.9), FIELD_N, tuning)
@@ -444,7 +449,7 @@ def test_magnetometer_innovation_square_equals_the_dense_one():
     covariances, attitudes and fields. 1e-11 relative: roundoff of the 3×3 adjugate inverse (S's condition number
     is below ~1e3 here) against numpy's solve."""
     rng = np.random.default_rng(18)
-    tuning = AttitudeTuning(field_direction_std=0.05)
+    tuning = dataclasses.replace(THESIS, field_direction_std=0.05)
     for seed in range(5):
         p = random_covariance(rng)
         q = quat(Rotation.random(random_state=30 + seed))

@@ -4,6 +4,7 @@ anti-windup, the allocation through the airframe's mixing, the per-flight totals
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import jax
@@ -17,9 +18,11 @@ from rocketmc.dynamics.servo import ServoParams, ServoState
 from rocketmc.gnc import design
 from rocketmc.gnc import control
 from rocketmc.gnc.control import GAIN_NAMES, GncParams, GncState, control_summary, gains_at, initial_gnc, lqi_command
-from rocketmc.gnc.guidance import GuidanceParams, Navigation
+from rocketmc.gnc.guidance import Navigation
 from rocketmc.math import Quat, Vec3
 from rocketmc.math.table import Table
+
+from .test_guidance import THESIS
 
 DT = 0.02
 LIMIT = math.radians(10.0)
@@ -53,8 +56,8 @@ def schedule():
 def params(schedule):
     table = Table.from_numpy((SPEEDS, ALTITUDES), schedule.gains.reshape(4, 2, -1), ("speed", "altitude"), GAIN_NAMES)
     servo = ServoParams(jnp.asarray(0.0769), jnp.asarray(LIMIT), jnp.zeros(4))
-    guidance = jax.tree_util.tree_map(jnp.asarray, GuidanceParams())
-    return GncParams(servo, guidance, table)
+    guidance = THESIS
+    return GncParams(servo, guidance, table, anti_windup=True, navigation="truth")
 
 
 def flying(speed=100.0, pitch_deg=80.0, omega=Vec3(0.0, 0.0, 0.0)) -> Navigation:
@@ -140,7 +143,7 @@ def test_anti_windup_holds_only_the_integrators_that_would_wind_further(params):
     first = gnc_step(params, after_liftoff(params, integrators=e), flying(100.0, 60.0), 2.0, DT, 1000.0, False)
     assert bool(first.saturated) and float(first.command.y) < -LIMIT
     np.testing.assert_array_equal(np.abs(np.asarray(first.servo.command_rad)).max(), LIMIT)
-    free = GncParams(params.servo, params.guidance, params.gains, anti_windup=False)
+    free = dataclasses.replace(params, anti_windup=False)
     for q, held in ((0.5, True), (-0.5, False)):
         nav = flying(100.0, 60.0, Vec3(0.0, q, 0.0))
         new, moved = (gnc_step(g, first, nav, 2.02, DT, 1000.0, False).integrators for g in (params, free))

@@ -8,6 +8,7 @@ so a rotation axis in the body's y-z plane is the one the command must return.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import jax
@@ -15,9 +16,11 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from rocketmc.campaign.gains import GuidanceReference
+from rocketmc.campaign.model import guidance_params
+from rocketmc.campaign.schema import GuidanceConfig
 from rocketmc.env.atmosphere import G0
 from rocketmc.gnc.guidance import (
-    GuidanceParams,
     Navigation,
     guidance_active,
     integrate_errors,
@@ -27,6 +30,11 @@ from rocketmc.gnc.guidance import (
 from rocketmc.math.vectors import Quat, Vec3
 
 DEG = math.pi / 180.0
+THESIS = guidance_params(GuidanceConfig(), GuidanceReference(apogee_m=1614.0, t0_s=GuidanceConfig().t0_s,
+                                                             flight_path_angle_deg=84.0, heading_deg=130.0,
+                                                             roll_heading_deg=90.0, derived=()))  # fmt: skip
+"""The thesis's guidance (docs/gnc.md §4): the schema's defaults, and the thesis's reference (H 1614 m, γ0 84°,
+heading 130°, roll heading 90°)."""
 # Unit vectors and angles rebuilt through a few trig functions and quaternion rotations round at a few ulps
 # (~1e-16); 1e-13 leaves room for that and is far below anything a controller could notice.
 ROUND = 1e-13
@@ -45,7 +53,7 @@ def axis_angle(axis: Vec3, angle: float) -> Quat:
 def test_reference_is_the_thesis_parabola():
     """d_ref at t0 has flight-path angle γ0 and heading ψ; it is level at the apex t0 + √(2H/g0) and is the
     direction of the point mass with v_x = √(2 g0 H)/tan γ0 and vertical speed √(2 g0 H) − g0 (t − t0)."""
-    p = GuidanceParams()
+    p = THESIS
     assert float(p.apogee_m) == 1614.0 and float(p.t0_s) == 1.5 and float(p.gain) == 5.0
     assert math.isclose(math.sqrt(2 * G0 * 1614.0), 177.92, abs_tol=5e-3)  # docs/gnc.md's c1 [m/s], to its digits
     assert math.isclose(math.sqrt(2 * G0 * 1614.0) / math.tan(84 * DEG), 18.70, abs_tol=5e-3)  # v_x [m/s]
@@ -67,7 +75,7 @@ def test_reference_is_the_thesis_parabola():
 def test_on_the_reference_the_command_is_zero(t):
     """Velocity along the parabola, body x along it with the body z axis toward the roll heading: χ = 0 and
     ω_cmd = 0 (to the rounding of V×d, ~1e-16 per unit vector)."""
-    p = GuidanceParams(roll_heading_rad=130 * DEG)
+    p = dataclasses.replace(THESIS, roll_heading_rad=130 * DEG)
     c1 = math.sqrt(2 * G0 * 1614.0)
     v_x = c1 / math.tan(84 * DEG)
     vz = c1 - G0 * (t - 1.5)
@@ -94,8 +102,8 @@ def turned_velocity(yaw, pitch, roll, beta, theta):
     v_n = q_nb.rotate(Vec3(1.0, 0.0, 0.0)) * 150.0
     axis_n = q_nb.rotate(Vec3(0.0, math.cos(beta * DEG), math.sin(beta * DEG)))
     d = axis_angle(axis_n, theta * DEG).rotate(v_n) * (1.0 / 150.0)
-    params = GuidanceParams(
-        flight_path_angle_rad=jnp.arcsin(-d.z), heading_rad=jnp.arctan2(d.y, d.x), roll_heading_rad=yaw * DEG
+    params = dataclasses.replace(
+        THESIS, flight_path_angle_rad=jnp.arcsin(-d.z), heading_rad=jnp.arctan2(d.y, d.x), roll_heading_rad=yaw * DEG
     )
     return nav(v_n, q_nb), params, params.t0_s
 
@@ -142,7 +150,7 @@ def test_the_rate_limit_holds_the_direction(attitude, beta):
 def test_roll_command_steers_body_z_toward_the_heading(yaw, pitch, roll, p_expected):
     """With the roll heading equal to the body's 3-2-1 yaw, the body z axis points at it when the roll is 0,
     so the roll error is −roll and p = clip(−roll_gain·roll, ±20 °/s) (roll_gain 1 1/s)."""
-    params = GuidanceParams(roll_heading_rad=yaw * DEG)
+    params = dataclasses.replace(THESIS, roll_heading_rad=yaw * DEG)
     q_nb = Quat.from_euler(yaw * DEG, pitch * DEG, roll * DEG)
     cmd, _ = rate_command(params, nav(q_nb.rotate(Vec3(100.0, 0.0, 0.0)), q_nb), 5.0)
     assert math.isclose(float(cmd.x), p_expected * DEG, abs_tol=ROUND)
@@ -152,8 +160,8 @@ def test_outside_the_window_the_command_is_zero_and_integrators_hold():
     """Before 1 s and from 10 s on (the window is [1, 10) s): ω_cmd = 0 exactly, χ still reported; the
     integrators keep their value bit for bit. Below 1 m/s the pitch and yaw command is zero, roll is not."""
     n, params, _ = turned_velocity(130.0, 84.0, 25.0, 40.0, 3.0)
-    params = GuidanceParams(
-        flight_path_angle_rad=params.flight_path_angle_rad, heading_rad=params.heading_rad, t0_s=5.0
+    params = dataclasses.replace(
+        THESIS, flight_path_angle_rad=params.flight_path_angle_rad, heading_rad=params.heading_rad, t0_s=5.0
     )
     _, chi_in = rate_command(params, n, 5.0)
     errors = Vec3(0.1, -0.2, 0.3)
@@ -174,7 +182,7 @@ def test_integrators_integrate_a_constant_error_exactly():
     float exactly, so 640 steps give N k_int (ω_cmd − ω) dt with no rounding; steps not active add nothing.
     The default gain is 1 (gnc/design.py's ė = ω_cmd − ω)."""
     command, rates = Vec3(0.75, 0.5, -0.375), Vec3(0.25, -0.5, 0.125)
-    gain = GuidanceParams().integrator_gain
+    gain = THESIS.integrator_gain
     dt = 2.0**-6
     active = jnp.arange(800) % 5 != 0  # 640 of 800 steps active
 
@@ -202,7 +210,7 @@ def test_vmap_matches_jit_bit_for_bit_and_eager_to_rounding():
         q_nb=Quat.from_array(quats),
         omega_b=Vec3.from_array(rng.normal(size=(m, 3))),
     )
-    params = GuidanceParams(apogee_m=jnp.asarray(rng.uniform(1000.0, 2000.0, m)))
+    params = dataclasses.replace(THESIS, apogee_m=jnp.asarray(rng.uniform(1000.0, 2000.0, m)))
     params = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(jnp.asarray(x, float), (m,)), params)
     times = jnp.asarray(rng.uniform(0.0, 12.0, m))
     errors = Vec3.from_array(rng.normal(size=(m, 3)))

@@ -13,6 +13,8 @@ import pytest
 import scipy.linalg
 import scipy.stats
 
+from rocketmc.campaign.model import position_tuning
+from rocketmc.campaign.schema import PositionFilterConfig
 from rocketmc.gnc.position_filter import (
     PositionEstimate,
     PositionTuning,
@@ -39,6 +41,8 @@ SHARP = PositionTuning(
     initial_position_std=5.0,
     initial_velocity_std=2.0,
 )
+THESIS = position_tuning(PositionFilterConfig())
+"""The thesis's tuning (docs/gnc.md §3): the schema's defaults."""
 
 propagate_jit = jax.jit(propagate_position)
 gnss_jit = jax.jit(gnss_update, static_argnames="horizontal_only")
@@ -87,7 +91,7 @@ def ref_nees(x, p, truth):
     return float(e @ np.linalg.solve(p, e))
 
 
-@pytest.mark.parametrize("tuning", [SHARP, PositionTuning()], ids=["sharp", "thesis"])
+@pytest.mark.parametrize("tuning", [SHARP, THESIS], ids=["sharp", "thesis"])
 def test_decoupled_filter_equals_the_6_state_filter(tuning):
     """Random inputs, periods and a random sequence of no update, full GNSS, horizontal GNSS, altitude, or GNSS and
     altitude together: means, covariances and NEES equal numpy's 6-state filter step by step."""
@@ -206,7 +210,7 @@ def elements(est, i):
     return np.array([[est.p_rr[i], est.p_rv[i]], [est.p_rv[i], est.p_vv[i]]], dtype=float)
 
 
-@pytest.mark.parametrize("tuning, steps", [(SHARP, 3000), (PositionTuning(), 20000)], ids=["sharp", "thesis"])
+@pytest.mark.parametrize("tuning, steps", [(SHARP, 3000), (THESIS, 20000)], ids=["sharp", "thesis"])
 def test_gnss_steady_state_solves_the_riccati_equation(tuning, steps):
     """Repeated propagate + GNSS update converge, per axis, to scipy's DARE solution (a priori) and its update (a
     posteriori). The slowest steady closed-loop pole, |eig((I − K) F)|, is 0.9833 per step for SHARP (τ = 1.2 s)

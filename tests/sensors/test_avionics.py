@@ -13,7 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.env.atmosphere import G0
 from rocketmc.env.magnetic import site_field_ned

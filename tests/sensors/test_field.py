@@ -16,7 +16,8 @@ import numpy as np
 import ppigrf
 import pytest
 
-from rocketmc.campaign.config import ConfigError, campaign_from_dict, sensor_spreads
+from rocketmc.campaign import ConfigError, campaign_from_dict
+from rocketmc.campaign.loader import sensor_spreads
 from rocketmc.campaign.model import filter_params
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.env.atmosphere import G0

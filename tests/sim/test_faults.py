@@ -18,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.dynamics.servo import ServoParams, ServoState, deflection_at
 from rocketmc.sim.faults import Faults, SlowCanard, StuckCanard, faulty_servos

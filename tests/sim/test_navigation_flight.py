@@ -20,7 +20,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.campaign.config import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.gnc.attitude_filter import attitude_error_b

@@ -10,11 +10,12 @@ other rows, the navigation and control metrics of ``sim/flight.py`` (medians and
 flights.
 
 A source is an entry of ``SOURCES``: a name, a description, the config overrides that switch it off (dotted path
--> value, applied by ``Campaign.with_overrides(values=...)``) and why switching it off would change nothing in a
-campaign (its sensor is not read, or it has no error already); such a source is reported, not flown. A sensor's
-errors are switched off by its ``truth_only``; the reference field's (``field_model``) by giving the filters the
-truth's model and zeroing the truth's anomaly, its dispersions removed. Each row is flown with
-``campaign.run_chunks`` (one compilation per row: a sensor's ``truth_only`` is a static switch).
+-> value, applied by ``with_overrides(campaign, values=...)``, the campaign loaded again with them) and why switching
+it off would change nothing in a campaign (its sensor is not read, or it has no error already); such a source is
+reported, not flown. A sensor's errors are switched off by its ``truth_only``; the reference field's
+(``field_model``) by giving the filters the truth's model and zeroing the truth's anomaly, its dispersions removed.
+Each row is flown with ``campaign.run_chunks`` (one compilation per row: a sensor's ``truth_only`` is a static
+switch).
 """
 
 from __future__ import annotations
@@ -25,8 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..campaign.config import Campaign, CampaignConfig
+from ..campaign.loader import with_overrides
+from ..campaign.record import Campaign
 from ..campaign.runner import run_chunks
+from ..campaign.schema import CampaignConfig
 from ..errors import RocketmcError
 from ..sim.flight import CONTROL_METRICS, NAVIGATION_METRICS
 from .ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
@@ -176,17 +179,17 @@ def budget_rows(campaign: Campaign, sources: Sequence[str] | None = None, refere
     rows = [Row("all", "campaign", "every source as the campaign has it", campaign)]
     busy = any(reason is None for reason in idle.values())
     rows.append(Row("none", "none", "every source off: navigation on perfect sensors and the truth's field",
-                    campaign.with_overrides(values=_merged(off.values())) if busy else None,
+                    with_overrides(campaign, values=_merged(off.values())) if busy else None,
                     None if busy else "every source changes nothing: the same flights as 'all'"))  # fmt: skip
     for name in names:
         others = _merged(overrides for other, overrides in off.items() if other != name)
         reason = None if idle[name] is None else f"{idle[name]}: the same flights as 'none'"
         rows.append(Row(name, "source", f"{SOURCES[name].description} alone",
-                        None if reason else campaign.with_overrides(values=others), reason))  # fmt: skip
+                        None if reason else with_overrides(campaign, values=others), reason))  # fmt: skip
     if references:
         rows.append(Row("truth", "reference", "perfect navigation (navigation = 'truth')",
-                        campaign.with_overrides(navigation="truth")))  # fmt: skip
-        rows.append(Row("off", "reference", "controller off (canards neutral)", campaign.with_overrides(controller=False)))
+                        with_overrides(campaign, navigation="truth")))  # fmt: skip
+        rows.append(Row("off", "reference", "controller off (canards neutral)", with_overrides(campaign, controller=False)))
     return rows
 
 

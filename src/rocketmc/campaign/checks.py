@@ -14,7 +14,7 @@ from ..aero.model import LinearAero
 from ..aero.stability import static_margin_calibers
 from ..sim.flight import OUTSIDE_TABLES_QBAR_FRACTION, mass_properties
 from ..sim.params import FlightParams
-from .config import Campaign
+from .record import Campaign
 from .model import nominal_params
 
 MARGIN_MACH = 0.3

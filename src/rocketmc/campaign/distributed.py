@@ -35,7 +35,7 @@ from distributed.comm import CommClosedError
 
 from .. import __version__
 from ..errors import RocketmcError
-from .config import Campaign
+from .record import Campaign
 from .fingerprint import differences, setup
 from .runner import ChunkResult, batch_size, chunking, compiled_chunk, fly_chunk
 

@@ -20,7 +20,7 @@ import jax
 import numpy as np
 
 from .. import PRECISION, __version__
-from .config import Campaign
+from .record import Campaign
 
 PACKAGES = ("jax", "jaxlib", "numpy", "scipy")
 """The packages whose versions can change a flight's bits, besides rocketmc."""

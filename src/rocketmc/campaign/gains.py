@@ -1,5 +1,6 @@
 """The LQI gain schedule of a campaign with a ``[gnc]`` section (docs/gnc.md §5), designed once on the host
-when the campaign loads (``config.campaign_from_dict``, ``Campaign.with_overrides``).
+when the campaign loads (``loader.campaign_from_dict``), from its validated config and its nominal airframe
+(``model.airframe_params``: the rocket, its rail and the air, without the closed loop).
 
 Each grid point (axial speed u [m/s], altitude) is ``gnc.design``'s linear plant built from the
 campaign's own aerodynamic model at α = β = δ = 0 (its simplified form: the linear model as given,
@@ -11,7 +12,6 @@ guidance reference's climb when the campaign leaves it out (``guidance_reference
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 from typing import NamedTuple
@@ -28,9 +28,9 @@ from ..env.atmosphere import G0, AtmosphereProfile, air
 from ..gnc.design import FlownLoopUnstable, PlantPoint, Schedule, gain_schedule
 from ..math.vectors import Vec3
 from ..sim.flight import mass_properties
-from ..sim.params import FlightParams
-from .config import Campaign, ConfigError
-from .model import nominal_params
+from ..sim.params import FlightParams, Launch
+from .errors import ConfigError
+from .schema import CampaignConfig
 
 ESTIMATE_DT_S = 0.01
 """Step of the point-mass estimate [s]: Lynx's window speeds are within 0.3 % of a step ten times smaller."""
@@ -72,42 +72,41 @@ class DesignInputs(NamedTuple):
     reference: GuidanceReference | None = None
 
 
-def design_inputs(campaign: Campaign) -> DesignInputs:
-    """The ``DesignInputs`` of a campaign with a ``[gnc]`` section; ConfigError if its rocket has no
-    four canards or its nominal flight is not in the air during the guidance window."""
-    # The rocket and flight without the controller: its FlightParams need no gains.
-    params = nominal_params(dataclasses.replace(campaign, config=campaign.config.model_copy(update={"gnc": None})))
-    aero = params.rocket.aero
+def design_inputs(config: CampaignConfig, airframe: FlightParams) -> DesignInputs:
+    """The ``DesignInputs`` of a campaign with a ``[gnc]`` section from its config and its nominal ``airframe``
+    (``campaign.model.airframe_params``); ConfigError if its rocket has no four canards or its nominal flight is not
+    in the air during the guidance window."""
+    aero = airframe.rocket.aero
     aero = aero if isinstance(aero, LinearAero) else simplify(aero)
     if aero.n_canards != 4:
         raise ConfigError(f"gnc: the controller steers four canards; this rocket's aerodynamic model has "
                           f"{aero.n_canards} (rocket.geometry.canards)")  # fmt: skip
-    motor = params.rocket.motor
+    motor = airframe.rocket.motor
     times = jnp.arange(0.0, float(motor.ignition_time_s + motor.burn_time_s), ESTIMATE_DT_S)
-    mass, *arrays = _nominal_arrays(params, times, jnp.asarray(ESTIMATE_HEIGHTS_M))
-    guidance = campaign.config.gnc.guidance
-    speeds, altitudes, climb = nominal_estimate(params, aero, *map(np.asarray, arrays), guidance.window_start_s,
+    mass, *arrays = _nominal_arrays(airframe, times, jnp.asarray(ESTIMATE_HEIGHTS_M))
+    guidance = config.gnc.guidance
+    speeds, altitudes, climb = nominal_estimate(airframe, aero, *map(np.asarray, arrays), guidance.window_start_s,
                                                 guidance.window_end_s, guidance.t0_s)  # fmt: skip
-    return DesignInputs(aero, mass, 1.0 / campaign.config.gnc.servo.time_constant_s, speeds, altitudes,
-                        params.environment.atmosphere, guidance_reference(campaign, params, climb))  # fmt: skip
+    return DesignInputs(aero, mass, 1.0 / config.gnc.servo.time_constant_s, speeds, altitudes,
+                        airframe.environment.atmosphere, guidance_reference(config, airframe.launch, climb))  # fmt: skip
 
 
-def guidance_reference(campaign: Campaign, params: FlightParams, climb_m: float) -> GuidanceReference:
-    """The reference of the campaign's gnc.guidance, those of its fields left out derived from the nominal flight
-    ``params``: heading, the launch azimuth; flight-path angle, the rail's elevation (at most
-    MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG); roll heading, the azimuth of the horizontal direction that the rail's attitude
-    q_nb0 already steers to (perpendicular to the body y axis, on the body z axis's side: no roll error there, so no
-    roll manoeuvre at the window's start); apogee, ``climb_m`` [m], the nominal flight's climb after t0_s
-    (``nominal_estimate``). ConfigError naming gnc.guidance.apogee_m if that climb is not positive."""
-    g, launch = campaign.config.gnc.guidance, campaign.config.launch
-    y_b = params.launch.q_nb0.rotate(Vec3(0.0, 1.0, 0.0))
-    z_b = params.launch.q_nb0.rotate(Vec3(0.0, 0.0, 1.0))
+def guidance_reference(config: CampaignConfig, launch: Launch, climb_m: float) -> GuidanceReference:
+    """The reference of the campaign's gnc.guidance, those of its fields left out derived from the nominal flight:
+    heading, the launch azimuth; flight-path angle, the rail's elevation (at most MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG);
+    roll heading, the azimuth of the horizontal direction that the nominal rail's attitude ``launch.q_nb0`` already
+    steers to (perpendicular to the body y axis, on the body z axis's side: no roll error there, so no roll manoeuvre
+    at the window's start); apogee, ``climb_m`` [m], the nominal flight's climb after t0_s (``nominal_estimate``).
+    ConfigError naming gnc.guidance.apogee_m if that climb is not positive."""
+    g = config.gnc.guidance
+    y_b = launch.q_nb0.rotate(Vec3(0.0, 1.0, 0.0))
+    z_b = launch.q_nb0.rotate(Vec3(0.0, 0.0, 1.0))
     north, east = -float(y_b.y), float(y_b.x)  # ⟂ y_b and horizontal: D × y_b
     side = math.copysign(1.0, north * float(z_b.x) + east * float(z_b.y))
     derived = {
         "apogee_m": climb_m,
-        "flight_path_angle_deg": min(launch.elevation_deg, MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG),
-        "heading_deg": launch.azimuth_deg,
+        "flight_path_angle_deg": min(config.launch.elevation_deg, MAX_DERIVED_FLIGHT_PATH_ANGLE_DEG),
+        "heading_deg": config.launch.azimuth_deg,
         "roll_heading_deg": math.degrees(math.atan2(side * east, side * north)) % 360.0,
     }
     if g.apogee_m is None and not climb_m > 0.0:
@@ -220,10 +219,10 @@ def describe_reference(reference: GuidanceReference) -> str:
             f"({mark('roll_heading_deg')})")  # fmt: skip
 
 
-def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
+def check_coverage(config: CampaignConfig, inputs: DesignInputs) -> None:
     """ConfigError unless the design grid covers the estimated flight inside the guidance window (an
     altitude grid of one point designs gains for every altitude)."""
-    control, guidance = campaign.config.gnc.control, campaign.config.gnc.guidance
+    control, guidance = config.gnc.control, config.gnc.guidance
     grids = [("speeds_mps", control.speeds_mps, inputs.speeds, "m/s")]
     if len(control.altitudes_m) > 1:
         grids.append(("altitudes_m", control.altitudes_m, inputs.altitudes_agl, "m above the pad"))
@@ -236,13 +235,13 @@ def check_coverage(campaign: Campaign, inputs: DesignInputs) -> None:
             )
 
 
-def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
-    """The campaign's gain schedule from its ``design_inputs``: speeds [m/s], altitudes [m above mean sea
+def design_schedule(config: CampaignConfig, inputs: DesignInputs) -> Schedule:
+    """The campaign's gain schedule from its config and ``design_inputs``: speeds [m/s], altitudes [m above mean sea
     level] (the grid's altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming
     the field if the grid does not cover the flight, a point has no stabilising design or its loop as flown (the
     integrators stepped with gnc.guidance.integrator_gain) is not stable."""
-    check_coverage(campaign, inputs)
-    control = campaign.config.gnc.control
+    check_coverage(config, inputs)
+    control = config.gnc.control
     try:
         # One BLAS thread: on 11×11 matrices more only contend (measured 2.5 ms a point against 7-25 ms
         # on 2 busy cores), and the gains (in the set-up's fingerprint) are the same bits on any machine.
@@ -251,12 +250,12 @@ def design_schedule(campaign: Campaign, inputs: DesignInputs) -> Schedule:
                 lambda speed, altitude: plant_point(inputs.aero, inputs.mass, speed, altitude, inputs.omega_a,
                                                     inputs.atmosphere),
                 control.speeds_mps,
-                campaign.config.site.altitude_m + np.asarray(control.altitudes_m),
-                dt=campaign.config.simulation.control_dt_s,
+                config.site.altitude_m + np.asarray(control.altitudes_m),
+                dt=config.simulation.control_dt_s,
                 q=np.diag(control.q_weights),
                 r=np.diag(control.r_weights),
                 method=control.discretisation,
-                integrator_gain=campaign.config.gnc.guidance.integrator_gain,
+                integrator_gain=config.gnc.guidance.integrator_gain,
             )
     except FlownLoopUnstable as err:
         raise ConfigError(f"gnc.guidance.integrator_gain: {err} (lower the integrator gains or change the design's "
@@ -272,12 +271,12 @@ MAIN_GAINS = {"pitch": {"K_w": (1, 1), "K_q": (1, 3), "K_up": (1, 6), "K_eq": (1
 """The gains that act in the pitch and roll channels, by (row, column) of K; the yaw row mirrors pitch."""
 
 
-def schedule_summary(campaign: Campaign) -> dict:
-    """The campaign's gain schedule and what it was designed from, JSON-able (``rocketmc gnc design``):
+def schedule_summary(config: CampaignConfig, schedule: Schedule, inputs: DesignInputs) -> dict:
+    """A campaign's gain schedule and what it was designed from (``Campaign.gnc_schedule``, ``gnc_inputs``),
+    JSON-able (``rocketmc gnc design``):
     per grid point speed [m/s], altitude above the pad and above sea level [m], the designed closed loop's
     spectral radius and the loop's as flown (``gnc.design.flown_loop``), relative Riccati residual, K (3, 11)
     and its ``MAIN_GAINS``; the guidance reference, each value with whether it was derived (t0_s is always set)."""
-    config, schedule, inputs = campaign.config, campaign.gnc_schedule, campaign.gnc_inputs
     control = config.gnc.control
     points = [
         {

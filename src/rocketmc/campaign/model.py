@@ -14,7 +14,7 @@ from collections.abc import Mapping
 import jax
 import jax.numpy as jnp
 
-from ..aero.model import from_virtual_commands
+from ..aero.model import TableAero, from_virtual_commands
 from ..dynamics import Motor, Parachute
 from ..dynamics.propulsion import cumulative_impulse
 from ..dynamics.rigid_body import combine_on_axis
@@ -34,10 +34,14 @@ from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
 from ..sim.faults import Faults, GnssOutage, SensorStep, SlowCanard, StuckCanard
+from ..env.weather import Weather
 from ..sim.flight import rail_start_n
-from ..sim.params import Environment, FlightParams, Launch, Rocket
-from .config import Campaign, FiltersConfig, sample_period_ticks, sensor_ticks
+from ..sim.params import Environment, FlightParams, Launch, Rocket, SimSettings
+from .errors import ConfigError
+from .gains import GuidanceReference
+from .record import Campaign
 from .sampling import UNIT_FIELDS, realization_key, stream_key
+from .schema import AttitudeFilterConfig, CampaignConfig, FiltersConfig, GuidanceConfig, PositionFilterConfig
 
 
 def _vector(values: Mapping, path: str, n: int, suffix: str = ""):
@@ -45,18 +49,56 @@ def _vector(values: Mapping, path: str, n: int, suffix: str = ""):
     return jnp.stack([jnp.asarray(values[f"{path}.{i}{suffix}"], dtype=float) for i in range(n)])
 
 
+def _arrays(values: Mapping) -> dict:
+    return {k: jnp.asarray(x, dtype=float) for k, x in values.items()}
+
+
+def _body_x(config: CampaignConfig, v: Mapping):
+    """A position in the rocket's coordinates (dotted path of ``v``) -> body-frame x (forward) from the reference [m]."""
+    ref, sign = v["rocket.reference_point_m"], config.rocket.position_sign
+    return lambda path: sign * (ref - v[path])
+
+
 def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
     """FlightParams from ``values`` (dotted path -> scalar), the realization's ``key`` (the turbulence's
     noise) and the campaign's static structure."""
     cfg = campaign.config
-    v = {k: jnp.asarray(x, dtype=float) for k, x in values.items()}
+    airframe = airframe_params(cfg, campaign.thrust_time_s, campaign.thrust_n, campaign.aero, campaign.wind_profile,
+                               campaign.weather, values)  # fmt: skip
+    v = _arrays(values)
+    environment = dataclasses.replace(airframe.environment, turbulence=_turbulence(cfg, v, key))
+    avionics = _avionics(campaign, v, key, _body_x(cfg, v), airframe.rocket.aero.n_canards)
+    return dataclasses.replace(airframe, environment=environment, gnc=_gnc(campaign, v), avionics=avionics,
+                               faults=_faults(campaign, v, avionics))  # fmt: skip
+
+
+def airframe_params(
+    config: CampaignConfig, thrust_time_s, thrust_n, aero: TableAero | None, wind_profile, weather: Weather | None,
+    values: Mapping,
+) -> FlightParams:  # fmt: skip
+    """The flight of ``values`` (dotted path -> scalar) without turbulence, closed loop, sensors or faults: the rocket
+    with its thrust curve (``thrust_time_s`` [s], ``thrust_n`` [N]) and aerodynamic model (``aero``; None: the linear
+    one of ``values``), its rail, the mean wind (``wind_profile``: the measured one of ``model = "profile"``) and the
+    air (``weather``: the day's, None: the ISA). What the gains are designed for (``campaign.gains``) and what the
+    avionics know of the launch (``nominal_rail``)."""
+    v = _arrays(values)
+    rocket = _rocket(config, thrust_time_s, thrust_n, aero, v)
+    launch = Launch.from_angles(
+        v["launch.rail_length_m"], jnp.deg2rad(v["launch.elevation_deg"]), jnp.deg2rad(v["launch.azimuth_deg"])
+    )
+    environment = Environment(
+        site_altitude_m=jnp.asarray(config.site.altitude_m, dtype=float),
+        wind=_wind(config, wind_profile, weather, v),
+        atmosphere=_atmosphere(weather),
+    )
+    return FlightParams(rocket, launch, environment)
+
+
+def _rocket(cfg: CampaignConfig, thrust_time_s, thrust_n, table_aero: TableAero | None, v: Mapping) -> Rocket:
+    """The rocket from the values ``v``, its thrust curve [s], [N] and aerodynamic model (None: the linear one of
+    ``v``)."""
+    body_x = _body_x(cfg, v)
     ref = v["rocket.reference_point_m"]
-
-    sign = cfg.rocket.position_sign
-
-    def body_x(path):  # a position in the rocket's coordinates -> body-frame x (forward) from the reference
-        return sign * (ref - v[path])
-
     m = "rocket.motor"
     grain_center = (
         body_x(f"{m}.grain_center_m")
@@ -64,11 +106,11 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
         else body_x(f"{m}.nozzle_m") + 0.5 * v[f"{m}.grain_length_m"]
     )
     motor_dry_x = grain_center if cfg.rocket.motor.dry_cg_m is None else body_x(f"{m}.dry_cg_m")
-    thrust_n = jnp.asarray(campaign.thrust_n) * v[f"{m}.thrust_scale"]
+    scaled_thrust_n = jnp.asarray(thrust_n) * v[f"{m}.thrust_scale"]
     motor = Motor(
-        time_s=jnp.asarray(campaign.thrust_time_s),
-        thrust_n=thrust_n,
-        impulse_ns=jnp.asarray(cumulative_impulse(campaign.thrust_time_s, campaign.thrust_n)) * v[f"{m}.thrust_scale"],
+        time_s=jnp.asarray(thrust_time_s),
+        thrust_n=scaled_thrust_n,
+        impulse_ns=jnp.asarray(cumulative_impulse(thrust_time_s, thrust_n)) * v[f"{m}.thrust_scale"],
         ignition_time_s=v[f"{m}.ignition_delay_s"],
         propellant_mass_kg=v[f"{m}.propellant_mass_kg"],
         grain_outer_diameter_m=v[f"{m}.grain_outer_diameter_m"],
@@ -79,7 +121,7 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
     )
 
     a = "rocket.aero"
-    if campaign.aero is None:  # model = "linear": the coefficients may be dispersed
+    if table_aero is None:  # model = "linear": the coefficients may be dispersed
         lin = f"{a}.linear"
         n_mach = len(cfg.rocket.aero.linear.ca0_mach)
         aero = from_virtual_commands(
@@ -95,7 +137,7 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
                                              "cy_r", "cn_q", "cl_p", "cm_q")},
         )  # fmt: skip
     else:
-        aero = dataclasses.replace(campaign.aero, drag_scale=v[f"{a}.drag_scale"], cl0=v[f"{a}.cl0"])
+        aero = dataclasses.replace(table_aero, drag_scale=v[f"{a}.drag_scale"], cl0=v[f"{a}.cl0"])
 
     parachutes = []
     for i, chute in enumerate(cfg.rocket.parachutes):
@@ -134,17 +176,7 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
             airbrake_time_s=_vector(v, "rocket.airbrakes.time_s", n),
             airbrake_delta_ca=_vector(v, "rocket.airbrakes.delta_ca", n),
         )
-    launch = Launch.from_angles(
-        v["launch.rail_length_m"], jnp.deg2rad(v["launch.elevation_deg"]), jnp.deg2rad(v["launch.azimuth_deg"])
-    )
-    environment = Environment(
-        site_altitude_m=jnp.asarray(cfg.site.altitude_m, dtype=float),
-        wind=_wind(campaign, v),
-        turbulence=_turbulence(campaign, v, key),
-        atmosphere=_atmosphere(campaign),
-    )
-    avionics = _avionics(campaign, v, key, body_x, aero.n_canards)
-    return FlightParams(rocket, launch, environment, _gnc(campaign, v), avionics, _faults(campaign, v, avionics))
+    return rocket
 
 
 def _faults(campaign: Campaign, v: Mapping, avionics: Avionics | None) -> Faults | None:
@@ -202,16 +234,7 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
         offset_rad=jnp.deg2rad(_vector(v, f"{s}.offset_deg", len(gnc.servo.offset_deg))),
         rate_limit_rad_s=None if rate_limit is None else jnp.deg2rad(v[f"{s}.rate_limit_deg_s"]),
     )
-    g, ref = gnc.guidance, campaign.gnc_inputs.reference  # the reference: set, or derived at set-up
-    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
-    guidance = GuidanceParams(
-        apogee_m=jnp.asarray(ref.apogee_m), t0_s=jnp.asarray(g.t0_s), flight_path_angle_rad=rad(ref.flight_path_angle_deg),
-        heading_rad=rad(ref.heading_deg), gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s),
-        min_speed=jnp.asarray(g.min_speed_mps), roll_gain=jnp.asarray(g.roll_gain),
-        roll_heading_rad=rad(ref.roll_heading_deg), roll_rate_limit=rad(g.roll_rate_limit_deg_s),
-        integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
-        window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
-    )  # fmt: skip
+    guidance = guidance_params(gnc.guidance, campaign.gnc_inputs.reference)  # the reference: set, or derived
     schedule = campaign.gnc_schedule
     gains = schedule.gains.reshape(*schedule.gains.shape[:2], -1)  # (speed, altitude, 33)
     if schedule.altitudes.size > 1:
@@ -223,11 +246,24 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
     return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation, filters, *rail)
 
 
+def guidance_params(g: GuidanceConfig, reference: GuidanceReference) -> GuidanceParams:
+    """Guidance from [gnc.guidance] and the reference it steers to (``campaign.gains.guidance_reference``), in SI."""
+    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
+    return GuidanceParams(
+        apogee_m=jnp.asarray(reference.apogee_m), t0_s=jnp.asarray(g.t0_s),
+        flight_path_angle_rad=rad(reference.flight_path_angle_deg), heading_rad=rad(reference.heading_deg),
+        gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s), min_speed=jnp.asarray(g.min_speed_mps),
+        roll_gain=jnp.asarray(g.roll_gain), roll_heading_rad=rad(reference.roll_heading_deg),
+        roll_rate_limit=rad(g.roll_rate_limit_deg_s), integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
+        window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
+    )  # fmt: skip
+
+
 def nominal_rail(campaign: Campaign) -> tuple[Quat, Vec3]:
     """What the avionics know of the launch: the campaign's nominal rail (its configured elevation and azimuth, not a
     realization's draw), its attitude (body → NED) and the nominal rocket's CG at rest on it [m, NED]."""
-    airframe = nominal_params(dataclasses.replace(campaign, config=campaign.config.model_copy(
-        update={"gnc": None, "avionics": None})))  # fmt: skip
+    airframe = airframe_params(campaign.config, campaign.thrust_time_s, campaign.thrust_n, campaign.aero,
+                               campaign.wind_profile, campaign.weather, campaign.nominal)  # fmt: skip
     return airframe.launch.q_nb0, rail_start_n(airframe)
 
 
@@ -238,22 +274,30 @@ def filter_params(campaign: Campaign) -> FilterParams:
     config = campaign.config
     f, site = (FiltersConfig() if config.gnc is None else config.gnc.filters), config.site
     a, p = f.attitude, f.position
-    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
-    attitude = AttitudeTuning(rad(a.gyro_noise_deg_s), rad(a.bias_walk_deg_s2), jnp.asarray(a.field_direction_std),
-                              rad(a.initial_attitude_std_deg), rad(a.initial_bias_std_deg_s))  # fmt: skip
-    position = PositionTuning(
-        jnp.asarray(p.position_noise_m), jnp.asarray(p.velocity_noise_mps), Vec3(*map(jnp.asarray, p.gnss_position_std_m)),
-        Vec3(*map(jnp.asarray, p.gnss_velocity_std_mps)), jnp.asarray(p.altitude_std_m),
-        jnp.asarray(p.initial_position_std_m), jnp.asarray(p.initial_velocity_std_mps),
-    )  # fmt: skip
     model = a.field_model or config.environment.magnetic_field.model
     with jax.ensure_compile_time_eval():  # the site's numbers: constants of the flight, even under jit
         field_t, gradient = (site_field_gradient(site.latitude_deg, site.longitude_deg, site.altitude_m)
                              if model == "dipole" else _igrf(config))  # fmt: skip
-    return FilterParams(attitude, position, jnp.asarray(field_t), jnp.asarray(gradient), jnp.asarray(p.gnss_after_s),
+    return FilterParams(attitude_tuning(a), position_tuning(p), jnp.asarray(field_t), jnp.asarray(gradient), jnp.asarray(p.gnss_after_s),
                         jnp.asarray(level_fraction(config)), 0 if f.initialisation == "rail" else f.pad_samples,
                         f.initialisation == "pad", p.gnss == "horizontal", p.barometer, a.field_gate, p.gnss_gate,
                         p.altitude_gate)  # fmt: skip
+
+
+def attitude_tuning(a: AttitudeFilterConfig) -> AttitudeTuning:
+    """The MEKF's tuning from [gnc.filters.attitude], in SI."""
+    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
+    return AttitudeTuning(rad(a.gyro_noise_deg_s), rad(a.bias_walk_deg_s2), jnp.asarray(a.field_direction_std),
+                          rad(a.initial_attitude_std_deg), rad(a.initial_bias_std_deg_s))  # fmt: skip
+
+
+def position_tuning(p: PositionFilterConfig) -> PositionTuning:
+    """The position/velocity filter's tuning from [gnc.filters.position], in SI."""
+    return PositionTuning(
+        jnp.asarray(p.position_noise_m), jnp.asarray(p.velocity_noise_mps), Vec3(*map(jnp.asarray, p.gnss_position_std_m)),
+        Vec3(*map(jnp.asarray, p.gnss_velocity_std_mps)), jnp.asarray(p.altitude_std_m),
+        jnp.asarray(p.initial_position_std_m), jnp.asarray(p.initial_velocity_std_mps),
+    )  # fmt: skip
 
 
 def level_fraction(config) -> float:
@@ -374,7 +418,7 @@ def _true_field(campaign: Campaign, v: Mapping) -> tuple:
 
 def _soft_iron(campaign: Campaign, v: Mapping):
     """The magnetometer's soft-iron matrix (3, 3) [-] from the (possibly drawn) values ``v``; with a per-flight
-    spread, the lower triangle follows the upper's draws (``config.SPREAD_ELEMENTS``): a symmetric perturbation of
+    spread, the lower triangle follows the upper's draws (``schema.SPREAD_ELEMENTS``): a symmetric perturbation of
     the configured matrix."""
     path = "avionics.magnetometer.soft_iron"
     matrix = _vector(v, path, 9).reshape(3, 3)
@@ -384,25 +428,24 @@ def _soft_iron(campaign: Campaign, v: Mapping):
     return matrix + jnp.triu(matrix - nominal, 1).T
 
 
-def _atmosphere(campaign: Campaign) -> AtmosphereProfile | None:
+def _atmosphere(weather: Weather | None) -> AtmosphereProfile | None:
     """The day's atmosphere of [environment.atmosphere] (None without: the ISA)."""
-    weather = campaign.weather
     if weather is None:
         return None
     return AtmosphereProfile(jnp.asarray(weather.geopotential_height_m), jnp.asarray(weather.temperature_k),
                              jnp.log(jnp.asarray(weather.pressure_pa)))  # fmt: skip
 
 
-def _wind(campaign: Campaign, v: Mapping):
-    """The mean wind of the campaign's model from the (possibly drawn) values ``v``: [environment.atmosphere]'s
-    profile when there is one (its levels' geometric heights above the pad, turned by wind_rotation_deg and
-    scaled by wind_scale), else [environment.wind]'s."""
-    weather, a = campaign.weather, "environment.atmosphere"
+def _wind(cfg: CampaignConfig, wind_profile, weather: Weather | None, v: Mapping):
+    """The mean wind of the campaign's model from the (possibly drawn) values ``v``: the day's ``weather``
+    ([environment.atmosphere]) when there is one (its levels' geometric heights above the pad, turned by
+    wind_rotation_deg and scaled by wind_scale), else [environment.wind]'s (``wind_profile``: its measured profile)."""
+    a = "environment.atmosphere"
     if weather is not None:
-        height = geometric_altitude(weather.geopotential_height_m) - campaign.config.site.altitude_m
+        height = geometric_altitude(weather.geopotential_height_m) - cfg.site.altitude_m
         return WindProfile.from_speed_direction(height, jnp.asarray(weather.speed_mps) * v[f"{a}.wind_scale"],
                                                 weather.from_rad + jnp.deg2rad(v[f"{a}.wind_rotation_deg"]))  # fmt: skip
-    config, w = campaign.config.environment.wind, "environment.wind"
+    config, w = cfg.environment.wind, "environment.wind"
     if config.model == "layers":
         n = len(config.layers)
         bottoms = [jnp.zeros(())]
@@ -417,12 +460,12 @@ def _wind(campaign: Campaign, v: Mapping):
         return PowerLawWind(
             v[f"{w}.speed_mps"], v[f"{w}.reference_height_m"], v[f"{w}.exponent"], jnp.deg2rad(v[f"{w}.from_deg"])
         )
-    altitude, speed, from_rad = campaign.wind_profile
+    altitude, speed, from_rad = wind_profile
     return WindProfile.from_speed_direction(altitude, jnp.asarray(speed) * v[f"{w}.speed_scale"], from_rad)
 
 
-def _turbulence(campaign: Campaign, v: Mapping, key) -> Turbulence | None:
-    if campaign.config.environment.turbulence is None:
+def _turbulence(cfg: CampaignConfig, v: Mapping, key) -> Turbulence | None:
+    if cfg.environment.turbulence is None:
         return None
     t = "environment.turbulence"
     return Turbulence.from_severity(v[f"{t}.severity"], stream_key(key, t), v.get(f"{t}.w20_mps"))
@@ -431,3 +474,27 @@ def _turbulence(campaign: Campaign, v: Mapping, key) -> Turbulence | None:
 def nominal_params(campaign: Campaign) -> FlightParams:
     """FlightParams of the nominal (undispersed) flight; its turbulence noise is realization 0's."""
     return flight_params(campaign, campaign.nominal, realization_key(jax.random.key(campaign.config.seed), 0))
+
+
+def sensor_ticks(config: CampaignConfig, seconds: float, field: str) -> int:
+    """``seconds`` as a whole number of GNC periods (``simulation.control_dt_s``); ConfigError naming
+    ``field`` if it is not one."""
+    dt = config.simulation.control_dt_s
+    ticks = round(seconds / dt)
+    if abs(ticks * dt - seconds) > 1e-9 * max(seconds, dt):
+        raise ConfigError(f"{field}: {seconds:g} s is not a whole number of GNC periods "
+                          f"(simulation.control_dt_s = {dt:g} s)")  # fmt: skip
+    return ticks
+
+
+def sample_period_ticks(config: CampaignConfig, sensor: str) -> int:
+    """The GNC periods between two samples of ``sensor``; ConfigError unless its rate divides the GNC rate into a
+    divisor of ``SimSettings.block_steps`` (a sensor's noise is drawn a block at a time, for its samples only)."""
+    dt, rate = config.simulation.control_dt_s, getattr(config.avionics, sensor).rate_hz
+    every = round(1.0 / (rate * dt))
+    if every < 1 or abs(every * rate * dt - 1.0) > 1e-9 or SimSettings.block_steps % every:
+        rates = ", ".join(f"{1 / (k * dt):g}" for k in (1, 2, 5, 10))
+        raise ConfigError(f"avionics.{sensor}.rate_hz: {rate:g} Hz does not divide the GNC rate ({1 / dt:g} Hz, "
+                          f"simulation.control_dt_s = {dt:g} s) into a divisor of {SimSettings.block_steps} GNC "
+                          f"periods (the noise blocks): e.g. {rates} Hz")  # fmt: skip
+    return every

@@ -1,5 +1,5 @@
 """The reference of every campaign key (type, unit, default, range, meaning, whether dispersible), generated
-from the schema (``campaign/config.py``) so that it cannot drift from it. Regenerate the committed page with
+from the schema (``campaign/schema.py``) so that it cannot drift from it. Regenerate the committed page with
 
     python -m rocketmc.campaign.reference > docs/campaign_reference.md
 
@@ -17,7 +17,8 @@ from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
-from .config import DISPERSIBLE_SECTIONS, CampaignConfig, _SensorConfig, fixed_reason
+from .limits import DISPERSIBLE_SECTIONS, fixed_reason
+from .schema import CampaignConfig, SensorConfig
 
 UNITS = {
     "_deg_s2": "deg/s²", "_deg_s": "deg/s", "_per_kpa": "unit/kPa", "_kgm2": "kg·m²", "_m2": "m²", "_mps2": "m/s²", "_mps": "m/s", "_kpa": "kPa", "_kg": "kg", "_deg": "deg",
@@ -95,7 +96,7 @@ def _numeric(annotation) -> bool:
 def _default(field: FieldInfo, model: type[BaseModel]) -> str:
     """A field's default as written in TOML; a sensor's required keys come from its part file."""
     if field.is_required():
-        return "from the part" if issubclass(model, _SensorConfig) else "required"
+        return "from the part" if issubclass(model, SensorConfig) else "required"
     value = field.get_default(call_default_factory=True) if field.default is PydanticUndefined else field.default
     if isinstance(value, BaseModel):
         return "its defaults"
@@ -140,7 +141,7 @@ def reference() -> str:
     lines = [
         "# Campaign keys",
         "",
-        "Every key of a campaign file, generated from the schema (`src/rocketmc/campaign/config.py`); do not edit by",
+        "Every key of a campaign file, generated from the schema (`src/rocketmc/campaign/schema.py`); do not edit by",
         "hand: `python -m rocketmc.campaign.reference > docs/campaign_reference.md` regenerates it. Units follow the",
         "name's suffix (`_m`, `_s`, `_deg`, `_mps`, ...) or are said in the meaning; positions are in the rocket's",
         "coordinates (`rocket.coordinate_system`). `<i>` is a list index, `<path>` a dotted key. Dispersible: a",

@@ -27,7 +27,7 @@ from ..pytree import tree_where
 from ..sim.flight import fly_block, flight_done, flight_summary, initial_state, simulate_one
 from ..sim.params import FlightParams
 from ..sim.params import SimSettings
-from .config import Campaign
+from .record import Campaign
 from .fingerprint import fingerprint, setup
 from .model import flight_params
 from .sampling import realization_key, sample_dispersions, sample_faults

@@ -12,7 +12,8 @@ import zlib
 import jax
 import jax.numpy as jnp
 
-from .config import Campaign, FaultsConfig
+from .record import Campaign
+from .schema import FaultsConfig
 
 
 def realization_key(master_key, index):

@@ -19,7 +19,8 @@ import pandas as pd
 
 from ..env.site import latitude_longitude_deg
 from ..sim.flight import fly
-from .config import Campaign, ConfigError
+from .errors import ConfigError
+from .record import Campaign
 from .runner import realization_params, sim_settings
 
 AFTER_LANDING_S = 20.0

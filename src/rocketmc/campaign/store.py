@@ -30,7 +30,7 @@ from .. import __version__
 from ..errors import RocketmcError
 from ..files import replacing, replacing_hdf5
 from ..sim.flight import Status, metric
-from .config import Campaign
+from .record import Campaign
 from .fingerprint import differences, fingerprint, setup
 from .runner import ChunkResult, chunking
 

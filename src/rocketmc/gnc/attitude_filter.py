@@ -58,18 +58,19 @@ _SERIES = {m: [(-1.0) ** n / math.factorial(2 * n + m) for n in range(_SERIES_TE
 
 @pytree_dataclass
 class AttitudeTuning:
-    """The filter's noise model, the thesis's values (docs/gnc.md §2) as defaults.
+    """The filter's noise model (docs/gnc.md §2), from the campaign's [gnc.filters.attitude]
+    (``campaign.model.attitude_tuning``).
 
     gyro_noise: σ_v, gyro white-noise density [rad/s/√s]; bias_walk: σ_u, gyro-bias random-walk density
     [rad/s²/√s]; field_direction_std: σ_b, per-axis std of the measured unit field direction [-] (R = σ_b² I);
     initial_attitude_std [rad] and initial_bias_std [rad/s]: per axis, P0 = diag(σ_ϑ² I, σ_β² I).
     """
 
-    gyro_noise: jnp.ndarray = math.radians(60.0)
-    bias_walk: jnp.ndarray = math.radians(10.0)
-    field_direction_std: jnp.ndarray = 2.0
-    initial_attitude_std: jnp.ndarray = 1.0
-    initial_bias_std: jnp.ndarray = 1.0
+    gyro_noise: jnp.ndarray
+    bias_walk: jnp.ndarray
+    field_direction_std: jnp.ndarray
+    initial_attitude_std: jnp.ndarray
+    initial_bias_std: jnp.ndarray
 
 
 @pytree_dataclass

@@ -45,8 +45,8 @@ class GncParams:
     servo: ServoParams
     guidance: GuidanceParams
     gains: Table
-    anti_windup: bool = static_field(default=True)
-    navigation: str = static_field(default="truth")
+    anti_windup: bool = static_field()
+    navigation: str = static_field()
     filters: FilterParams | None = None
     rail_q_nb: Quat | None = None
     rail_r_n: Vec3 | None = None

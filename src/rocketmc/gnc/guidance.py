@@ -9,7 +9,6 @@ motion on the rail): the reference and the window share that clock.
 
 from __future__ import annotations
 
-import math
 
 import jax.numpy as jnp
 
@@ -34,7 +33,7 @@ class Navigation:
 
 @pytree_dataclass
 class GuidanceParams:
-    """Guidance parameters, the thesis's values (docs/gnc.md §4) as defaults.
+    """Guidance parameters (docs/gnc.md §4), from the campaign's [gnc.guidance] (``campaign.model.guidance_params``).
 
     Reference parabola: apogee_m, the height H [m] the reference climbs after t0_s [s]; flight_path_angle_rad,
     γ0, the reference's flight-path angle at t0 (above the horizon) [rad]; heading_rad, ψ, its azimuth
@@ -45,19 +44,19 @@ class GuidanceParams:
     acts for window_start_s ≤ t < window_end_s [s since liftoff].
     """
 
-    apogee_m: jnp.ndarray = 1614.0
-    t0_s: jnp.ndarray = 1.5
-    flight_path_angle_rad: jnp.ndarray = math.radians(84.0)
-    heading_rad: jnp.ndarray = math.radians(130.0)
-    gain: jnp.ndarray = 5.0
-    rate_limit: jnp.ndarray = math.radians(20.0)
-    min_speed: jnp.ndarray = 1.0
-    roll_gain: jnp.ndarray = 1.0
-    roll_heading_rad: jnp.ndarray = math.radians(90.0)
-    roll_rate_limit: jnp.ndarray = math.radians(20.0)
-    integrator_gain: Vec3 = Vec3(1.0, 12.0, 12.0)
-    window_start_s: jnp.ndarray = 1.0
-    window_end_s: jnp.ndarray = 10.0
+    apogee_m: jnp.ndarray
+    t0_s: jnp.ndarray
+    flight_path_angle_rad: jnp.ndarray
+    heading_rad: jnp.ndarray
+    gain: jnp.ndarray
+    rate_limit: jnp.ndarray
+    min_speed: jnp.ndarray
+    roll_gain: jnp.ndarray
+    roll_heading_rad: jnp.ndarray
+    roll_rate_limit: jnp.ndarray
+    integrator_gain: Vec3
+    window_start_s: jnp.ndarray
+    window_end_s: jnp.ndarray
 
 
 def guidance_active(params: GuidanceParams, t) -> jnp.ndarray:

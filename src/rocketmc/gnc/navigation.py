@@ -99,14 +99,14 @@ class FilterParams:
     field_n: jnp.ndarray
     field_gradient: jnp.ndarray
     gnss_after_s: jnp.ndarray
-    level_fraction: jnp.ndarray = 1.0
-    pad_samples: int = static_field(default=0)
-    heading_from_field: bool = static_field(default=True)
-    horizontal_only: bool = static_field(default=False)
-    barometer: bool = static_field(default=False)
-    field_gate: float | None = static_field(default=None)
-    gnss_gate: float | None = static_field(default=None)
-    altitude_gate: float | None = static_field(default=None)
+    level_fraction: jnp.ndarray
+    pad_samples: int = static_field()
+    heading_from_field: bool = static_field()
+    horizontal_only: bool = static_field()
+    barometer: bool = static_field()
+    field_gate: float | None = static_field()
+    gnss_gate: float | None = static_field()
+    altitude_gate: float | None = static_field()
 
 
 @pytree_dataclass

@@ -35,22 +35,22 @@ from ..pytree import pytree_dataclass
 
 @pytree_dataclass
 class PositionTuning:
-    """The filter's noise model, the thesis's values (docs/gnc.md §3) as defaults.
+    """The filter's noise model (docs/gnc.md §3), from the campaign's [gnc.filters.position]
+    (``campaign.model.position_tuning``).
 
     position_noise: σ_r, process-noise density on the position [m/√s] (Q_r = T σ_r²); velocity_noise: σ_v, on the
     velocity [m/s/√s] (Q_v = T σ_v²); gnss_position_std, gnss_velocity_std: GNSS measurement noise per axis N, E,
-    D [m], [m/s]; altitude_std: barometric altitude noise [m] (the thesis has no barometer: the default is the
-    campaign's, ``PositionFilterConfig.altitude_std_m``); initial_position_std,
+    D [m], [m/s]; altitude_std: barometric altitude noise [m]; initial_position_std,
     initial_velocity_std: the square roots of P0's diagonal [m], [m/s].
     """
 
-    position_noise: jnp.ndarray = 2.0
-    velocity_noise: jnp.ndarray = 1.0
-    gnss_position_std: Vec3 = Vec3(500.0, 500.0, 700.0)
-    gnss_velocity_std: Vec3 = Vec3(50.0, 50.0, 70.0)
-    altitude_std: jnp.ndarray = 5.0
-    initial_position_std: jnp.ndarray = 1.0
-    initial_velocity_std: jnp.ndarray = 1.0
+    position_noise: jnp.ndarray
+    velocity_noise: jnp.ndarray
+    gnss_position_std: Vec3
+    gnss_velocity_std: Vec3
+    altitude_std: jnp.ndarray
+    initial_position_std: jnp.ndarray
+    initial_velocity_std: jnp.ndarray
 
 
 @pytree_dataclass

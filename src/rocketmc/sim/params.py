@@ -6,7 +6,7 @@ import dataclasses
 
 import jax.numpy as jnp
 
-from ..aero import LinearAero
+from ..aero import LinearAero, TableAero
 from ..dynamics import Motor, Parachute
 from ..gnc.control import GncParams
 from ..sensors.avionics import Avionics
@@ -23,7 +23,8 @@ class Rocket:
 
     dry_mass_kg: mass without propellant [kg]; dry_cg_x_m: its CG on the body x axis from the
     reference point [m]; dry_ixx_kgm2, dry_iyy_kgm2: its inertia about that CG [kg·m²];
-    rear_lug_x_m: body-frame x of the rear launch lug [m]; canopy_cl_p: roll damping under canopy;
+    rear_lug_x_m: body-frame x of the rear launch lug [m]; aero: the aerodynamic model, linear or interpolated
+    from tables (``aero.model``); canopy_cl_p: roll damping under canopy;
     airbrake_time_s, airbrake_delta_ca: the airbrakes' extra axial-force coefficient against time since
     ignition [s] (linear in between, 0 outside), or None without airbrakes.
     """
@@ -34,7 +35,7 @@ class Rocket:
     dry_iyy_kgm2: jnp.ndarray
     rear_lug_x_m: jnp.ndarray
     motor: Motor
-    aero: LinearAero
+    aero: LinearAero | TableAero
     parachutes: tuple[Parachute, ...]
     canopy_cl_p: jnp.ndarray
     airbrake_time_s: jnp.ndarray | None = None

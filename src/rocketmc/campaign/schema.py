@@ -1,108 +1,61 @@
-"""Campaign files (TOML): schema, validation and loading, on the host.
-
-Errors are ``ConfigError`` with one line that names the field (dotted path), what was expected and
-what was found; the CLI prints it and exits with code 2.
-"""
+"""The campaign file's schema (pydantic): every table and key, its type, range, default and description, and the
+checks that belong to one table; loading, the checks across tables and files are ``campaign/loader.py``'s."""
 
 from __future__ import annotations
 
-import copy
-import dataclasses
-import hashlib
 import math
-import tomllib
-from collections.abc import Mapping
 from datetime import date, datetime, timezone
-from importlib import resources
-from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
-from ..aero.geometry import NOSE_KINDS, BoatTail, FinSet, Nose, RocketGeometry
-from ..aero.io import load_aero
-from ..aero.model import LinearAero, TableAero, simplify
-from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_increment, with_axial_curve, with_canards
-from ..aero.tables import AeroTables
-from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
-from ..env.atmosphere import G0
+from ..aero.geometry import NOSE_KINDS
 from ..env.magnetic import igrf_validity
-from ..errors import RocketmcError
-from ..gnc.design import Schedule
-from ..env.weather import Weather, WeatherError, read_weather
-from ..env.wind import POWER_LAW_FLOOR_M, read_wind_profile
-from ..math.table import Table
+from ..env.wind import POWER_LAW_FLOOR_M
 from ..sensors.parts import load_part, part_names
-from ..sim.params import SimSettings
-
-if TYPE_CHECKING:
-    from .gains import DesignInputs
-
-DISPERSIBLE_SECTIONS = ("rocket", "launch", "environment", "gnc", "avionics")
-FIXED_PER_CAMPAIGN = ("rocket.reference_point_m", "rocket.nose_position_m", "rocket.geometry.", "rocket.aero.")
-"""Numbers that define the body frame or build the aerodynamic tables once per campaign: not
-dispersible, except those of ``DISPERSIBLE_AERO``."""
-DISPERSIBLE_AERO = ("rocket.aero.drag_scale", "rocket.aero.cl0", "rocket.aero.linear.")
-FIXED_GNC = ("gnc.guidance.", "gnc.control.", "gnc.filters.")
-"""Guidance, the gain design and the navigation filters' tuning, set once per campaign (the gains are designed
-when it loads): not dispersible; the servos (``gnc.servo``) are."""
-FIXED_AVIONICS = ("rate_hz", "latency_s", *("_std", "_std_deg"))
-"""Ends of the avionics' numbers that are not dispersible: the schedule (rate, latency) is set per campaign,
-and the per-flight spreads are dispersions themselves."""
-ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
-
-# Physical ranges (docs/conventions.md, Campaign validation): every number is finite and within these, generous
-# for any student or amateur rocket, so that a typo or a unit slip is refused here instead of flying a campaign
-# of failed flights.
-MIN_MASS_KG = 1e-3  # 1 g, below any model rocket: the mass divides every force
-MAX_MASS_KG = 5000.0  # a few tonnes: the heaviest amateur rockets weigh under 2 t
-MIN_LENGTH_M = 1e-4  # 0.1 mm, thinner than any fin
-MAX_LENGTH_M = 100.0  # lengths and positions: amateur rockets are under 20 m long
-MAX_DIAMETER_M = 10.0  # diameters: amateur rockets are under 1 m across
-MAX_AREA_M2 = 1000.0  # canopy and reference areas: the largest cargo canopies have ~700 m²
-MIN_INERTIA_KGM2 = 1e-9  # a 1 g rod 5 mm across has an axial inertia of 3·10⁻⁹ kg·m²; it divides every moment
-MAX_INERTIA_KGM2 = 1e7  # a 5 t, 100 m rod about its middle has m·L²/12 ≈ 4·10⁶ kg·m²
-MAX_ISP_S = 500.0  # above any chemical motor (hydrogen-oxygen in vacuum: ~450 s)
-MAX_SCALE = 10.0  # multipliers of a measured curve (thrust, drag, wind): ×10 is a unit slip, not a dispersion
-MAX_DELAY_S = 60.0  # ignition delay, parachute delay and opening time: longer is a flight without that event
-MAX_FLIGHT_TIME_S = 3600.0  # a descent under a main canopy from 10 km takes under ~2000 s
-MAX_ALTITUDE_M = 100_000.0  # heights above ground: the standard atmosphere ends at 47 km (status 4 above)
-MAX_WIND_MPS = 150.0  # above the strongest jet-stream winds measured (~110 m/s)
-MAX_MACH = 25.0  # Mach axes: beyond any sounding rocket
-MAX_DRAG_COEFFICIENT = 10.0  # axial-force and canopy coefficients: a flat plate's is 1.2, a canopy's 0.8-2.2
-MAX_COEFFICIENT = 1000.0  # static derivatives and offsets [per rad]: 40 × Lynx's CNα (24 per rad)
-MAX_DAMPING_COEFFICIENT = 1e5  # damping derivatives [per ω·d/(2V)]: 50 × Lynx's Cmq (−1813)
-MIN_CONTROL_DT_S = 1e-3  # 1 kHz, the fastest flight-computer loops; a flight is max_time_s/control_dt_s periods
-MAX_REALIZATIONS = 10**8  # ~20 float64 outputs per flight: 10⁸ flights fill ~16 GB
-MAX_NAME_LENGTH = 128  # a campaign's name is a label, printed and stored in result files
-MAX_SPEED_MPS = 10_000.0  # speeds: Mach 25 (MAX_MACH) is ~8.5 km/s
-MAX_SERVO_TIME_CONSTANT_S = 1.0  # a servo slower than 1 s cannot follow a ~10 s guidance window (Lynx: 0.077 s)
-MAX_CANARD_LIMIT_DEG = 45.0  # canards stall beyond ~20°: 45° is a unit slip, not a servo
-MAX_SERVO_RATE_DEG_S = 10_000.0  # servos slew 60-1000 °/s
-MAX_RATE_DEG_S = 3600.0  # commanded body rates: ten turns a second is no guidance
-MAX_GUIDANCE_GAIN = 1000.0  # guidance [1/s] and integrator [-] gains: 200 × the thesis's; k·T ≫ 1 oscillates
-MAX_SENSOR_VALUE = 1e7  # any sensor's unit (m/s², deg/s, µT, Pa, deg): 1e7 Pa is 100 atmospheres
-MAX_SENSOR_LATENCY_S = 1.0  # a sensor later than a second is a logger, not a GNC input
-MAX_MISALIGNMENT_DEG = 10.0  # a sensor more than 10° off its mount is mounted elsewhere
-MAX_ANOMALY_NT = 100_000.0  # twice the main field: the strongest crustal anomalies (iron ores) reach ~tens of µT
-MAX_SOFT_IRON_STD = 0.5  # a soft-iron matrix half off the identity per flight is no calibration
-MAX_LENGTH_KM = 100.0  # GNSS errors: 100 km is no fix
-MAX_LQ_WEIGHT = 1e12  # LQI weights: only their ratios matter, and the DARE loses accuracy beyond 1e12 apart
-DEFAULT_SPEEDS_MPS = [20.0, 30.0, 40.0, 60.0, 80.0, 100.0, 150.0, 200.0, 250.0, 300.0]
-DEFAULT_ALTITUDES_M = [0.0, 1000.0, 2000.0]
-"""The default design grid [m/s] × [m above the pad]. Lynx's guidance window (1-10 s after liftoff, at
-Roccaraso) flies 62-183 m/s and 30-1220 m (``campaign/gains.py``' estimate), from its rail exit at 21 m/s
-when it opens at liftoff; the grid adds room for dispersions and winds. Interpolated linearly, these
-points give the main gains of Lynx's designs in between within 5 % (closer where the gains vary less
-than the ~1/u of K_p below 40 m/s), and within 0.1 % between these altitudes."""
-NORMAL_REACH_STD = 6.0
-"""An unclipped side of a normal dispersion is checked at mean ± 6·std: a draw beyond has a
-probability of ~1e-9."""
-
-
-class ConfigError(RocketmcError, ValueError):
-    """A campaign that cannot be flown; the message is one line naming the field."""
+from .errors import shown
+from .limits import (
+    DEFAULT_ALTITUDES_M,
+    DEFAULT_SPEEDS_MPS,
+    MAX_ALTITUDE_M,
+    MAX_ANOMALY_NT,
+    MAX_AREA_M2,
+    MAX_CANARD_LIMIT_DEG,
+    MAX_COEFFICIENT,
+    MAX_DAMPING_COEFFICIENT,
+    MAX_DELAY_S,
+    MAX_DIAMETER_M,
+    MAX_DRAG_COEFFICIENT,
+    MAX_FIELD_STEP_UT,
+    MAX_FLIGHT_TIME_S,
+    MAX_GATE,
+    MAX_GUIDANCE_GAIN,
+    MAX_INERTIA_KGM2,
+    MAX_ISP_S,
+    MAX_LENGTH_KM,
+    MAX_LENGTH_M,
+    MAX_LQ_WEIGHT,
+    MAX_MACH,
+    MAX_MASS_KG,
+    MAX_MISALIGNMENT_DEG,
+    MAX_NAME_LENGTH,
+    MAX_RATE_DEG_S,
+    MAX_REALIZATIONS,
+    MAX_SCALE,
+    MAX_SENSOR_LATENCY_S,
+    MAX_SENSOR_VALUE,
+    MAX_SERVO_RATE_DEG_S,
+    MAX_SERVO_TIME_CONSTANT_S,
+    MAX_SLOW_FACTOR,
+    MAX_SOFT_IRON_STD,
+    MAX_SPEED_MPS,
+    MAX_WIND_MPS,
+    MIN_CONTROL_DT_S,
+    MIN_INERTIA_KGM2,
+    MIN_LENGTH_M,
+    MIN_MASS_KG,
+)
 
 
 class _Strict(BaseModel):
@@ -270,21 +223,6 @@ class GeometryConfig(_Strict):
                              "the length from the nose tip to the aft end")  # fmt: skip
         return self
 
-    def to_geometry(self, from_nose=lambda position_m: position_m) -> RocketGeometry:
-        """The ``RocketGeometry``; ``from_nose`` maps a position to the distance from the nose tip."""
-
-        def fin_set(f: FinSetConfig) -> FinSet:
-            return FinSet(**{**f.model_dump(), "position_m": from_nose(f.position_m)})
-
-        return RocketGeometry(
-            self.body_diameter_m,
-            self.length_m,
-            Nose(**self.nose.model_dump()),
-            tuple(fin_set(f) for f in self.fins),
-            None if self.canards is None else fin_set(self.canards),
-            None if self.boat_tail is None
-            else BoatTail(**{**self.boat_tail.model_dump(), "position_m": from_nose(self.boat_tail.position_m)}),
-        )
 
 
 class ParachuteConfig(_Strict):
@@ -657,7 +595,6 @@ class ControlConfig(_Strict):
 ONE_RAD_DEG = math.degrees(1.0)
 """The thesis's initial covariances are identities: 1 rad and 1 rad/s, in the campaign's degrees."""
 StdDeviation = Annotated[float, Field(gt=0, le=MAX_SENSOR_VALUE)]
-MAX_GATE = 1e4  # a χ² gate of 1e4 on the normalised innovation squared is a 100σ gate: none at all
 Gate = Annotated[float | None, Field(gt=0, le=MAX_GATE)]
 """An update's χ² innovation gate [-]: fresh samples whose normalised innovation squared eᵀ S⁻¹ e exceeds it are
 rejected (``gnc.navigation.innovation_gate``); None (the default): no gate. E.g. the 99.7 % (3σ) quantiles: 8.8
@@ -751,7 +688,7 @@ SensorValue = Annotated[float, Field(ge=-MAX_SENSOR_VALUE, le=MAX_SENSOR_VALUE)]
 SensorSpread = Annotated[float, Field(ge=0, le=MAX_SENSOR_VALUE)]
 
 
-class _SensorConfig(_Strict):
+class SensorConfig(_Strict):
     """What every sensor has: its part (data/sensors/<part>.toml, whose values the other fields override),
     its sampling rate [Hz] (dividing the GNC rate), its latency [s] (a multiple of the GNC period) and a
     switch to turn its errors off (the truth at each sample, on the same schedule)."""
@@ -762,7 +699,7 @@ class _SensorConfig(_Strict):
     latency_s: float = Field(0.0, ge=0, le=MAX_SENSOR_LATENCY_S, description="a whole number of GNC periods")
 
 
-class ChannelConfig(_SensorConfig):
+class ChannelConfig(SensorConfig):
     """A channel of ``AXES`` axes in the sensor's unit (docs/sensors.md): range [low, high], LSB (0: no
     quantisation), white noise as a density [unit/√Hz] or per sample [unit] (one of the two), the constant
     bias and the standard deviation of its per-flight draw [unit] per axis, the bias instability as a rate
@@ -888,7 +825,7 @@ class CanardFeedbackConfig(RateChannelConfig):
     AXES: ClassVar[int] = 4
 
 
-class GnssConfig(_SensorConfig):
+class GnssConfig(SensorConfig):
     """A GNSS receiver: NED position and velocity fixes with white noise per fix (N, E, D) [m], [m/s], the slow
     sinusoidal position bias A·sin(2πft + φ) [m], [Hz], [deg] (its derivative on the velocity), and the time of
     the first fix [s from t = 0, the rocket on the pad]."""
@@ -907,7 +844,7 @@ class GnssConfig(_SensorConfig):
     first_fix_s: float = Field(0.0, ge=0, le=MAX_FLIGHT_TIME_S, description="time of the first fix from t = 0, on the pad")
 
 
-SENSOR_CONFIGS: dict[str, type[_SensorConfig]] = {
+SENSOR_CONFIGS: dict[str, type[SensorConfig]] = {
     "accelerometer": InertialConfig, "gyroscope": InertialConfig, "magnetometer": MagnetometerConfig,
     "barometer": BarometerConfig, "gnss": GnssConfig, "canard_feedback": CanardFeedbackConfig,
 }  # fmt: skip
@@ -945,11 +882,11 @@ class AvionicsConfig(_Strict):
             default = DEFAULT_PART  # the section's part provides other sensors: this one is the thesis's
         name = own.get("part", default)
         if not isinstance(name, str):
-            raise ValueError(f"part: expected a part name, got {_shown(name)}")
+            raise ValueError(f"part: expected a part name, got {shown(name)}")
         try:
             part = load_part(name)
         except KeyError:
-            raise ValueError(f"unknown part {_shown(name)} (known: {', '.join(part_names(info.field_name))})") from None
+            raise ValueError(f"unknown part {shown(name)} (known: {', '.join(part_names(info.field_name))})") from None
         if info.field_name not in part:
             raise ValueError(f"part {name!r} has no {info.field_name} (parts with one: "
                              f"{', '.join(part_names(info.field_name))})")  # fmt: skip
@@ -967,8 +904,6 @@ class AvionicsConfig(_Strict):
         return name
 
 
-MAX_SLOW_FACTOR = 100.0  # a servo 100× slower than Lynx's (0.077 s → 7.7 s) no longer moves in the window: stuck
-MAX_FIELD_STEP_UT = 10_000.0  # 200 × the geomagnetic field: a motor's current (~100 A at ~10 cm) makes ~200 µT
 FaultTime = Annotated[float, Field(ge=0, le=MAX_FLIGHT_TIME_S)]
 
 
@@ -1092,545 +1027,3 @@ class CampaignConfig(_Strict):
             raise ValueError(f"expected a label: 1 to {MAX_NAME_LENGTH} printable characters on one line, not blank")
         return name
 
-
-@dataclasses.dataclass(frozen=True)
-class Campaign:
-    """A validated campaign: the config, its TOML text, the thrust curve, the nominal values of
-    every dispersible number, keyed by dotted path (``"rocket.dry_mass_kg"``, ``"rocket.aero.ca0.2"``),
-    the aerodynamic model with its tables (None for ``model = "linear"``, built per flight), the
-    folder its relative file names are resolved from, the measured wind profile (altitude above
-    ground [m], speed [m/s], from-direction [rad]) when the wind model is ``profile``, and with a
-    [gnc] section the LQI gain schedule (``campaign/gains.py``): gains over speeds [m/s] × altitudes
-    [m above mean sea level: the grid's altitudes_m plus site.altitude_m], and what it was designed from
-    (``gains.DesignInputs``: the linearised aerodynamics, the rocket at burnout, the window estimate)."""
-
-    config: CampaignConfig
-    text: str
-    thrust_time_s: np.ndarray
-    thrust_n: np.ndarray
-    nominal: dict[str, float]
-    aero: TableAero | LinearAero | None
-    base_dir: Path
-    wind_profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-    files: dict[str, str] = dataclasses.field(default_factory=dict)
-    gnc_schedule: Schedule | None = None
-    gnc_inputs: DesignInputs | None = None
-    weather: Weather | None = None
-
-    def with_overrides(
-        self, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
-        controller: bool | None = None, sensors: bool | None = None, navigation: str | None = None,
-        values: Mapping[str, object] | None = None,
-    ) -> Campaign:  # fmt: skip
-        """The same campaign with N, the seed and/or the aerodynamic model replaced (CLI options); controller:
-        True adds a [gnc] section of defaults if there is none, False removes it and its servo dispersions
-        and its faults (the same flights with the canards neutral); sensors: True adds an [avionics] section of defaults
-        (the thesis's parts) if there is none and flies the controller on raw sensors (or on its filters, if the
-        campaign's navigation is "filters"), False removes it and its dispersions and flies the controller on
-        perfect navigation (their faults removed too); navigation: the controller's ("truth", "sensors" or "filters"), with sensors to match;
-        values: fields set by dotted path (``{"avionics.gyroscope.truth_only": True}``), after the options above, and
-        dispersions by their parameter's path after ``dispersions.``: a table sets one, None removes it."""
-        if navigation is not None:
-            sensors = navigation != "truth"
-        data = self.config.model_dump()
-        spreads = sensor_spreads(self.config)  # drawn by the sensors' spreads, not the file: redrawn from the new ones
-        data["dispersions"] = {k: d for k, d in data["dispersions"].items()
-                               if k not in spreads or self.config.dispersions[k] != spreads[k]}  # fmt: skip
-        data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
-        if aero_model is not None:
-            data["rocket"]["aero"]["model"] = aero_model
-        for section, on in (("gnc", controller), ("avionics", sensors)):
-            if on is not None and on != (data[section] is not None):
-                data[section] = {} if on else None
-                data["dispersions"] = {k: d for k, d in data["dispersions"].items() if on or not k.startswith(section + ".")}
-                if not on and data["faults"] is not None:  # its faults go with it
-                    data["faults"].update({name: None for name, s in FAULT_SECTIONS.items() if s == section})
-        if sensors is not None and data["gnc"] is not None:
-            current = data["gnc"].get("navigation", "truth")  # a [gnc] just added is empty: the schema's default
-            kept = current if current != "truth" else "sensors"
-            data["gnc"]["navigation"] = (navigation or kept) if sensors else "truth"
-        for path, value in (values or {}).items():
-            if path.startswith("dispersions."):  # a key of the dispersions' table is itself a dotted path
-                key = path.removeprefix("dispersions.")
-                if value is None and key not in data["dispersions"]:
-                    raise ConfigError(f"{path}: not a dispersion of this campaign")
-                data["dispersions"] = {k: d for k, d in data["dispersions"].items() if k != key}
-                data["dispersions"].update({} if value is None else {key: value})
-                continue
-            try:
-                data = _set_path(data, path, value)
-            except (KeyError, IndexError, TypeError, ValueError):
-                raise ConfigError(f"{path}: not a field of this campaign") from None
-        config = _validate(data)
-        config = _with_sensor_spreads(config)
-        campaign = dataclasses.replace(self, config=config, nominal=_nominal_values(config))
-        new_aero = config.rocket.aero.model != self.config.rocket.aero.model
-        if new_aero:
-            campaign = dataclasses.replace(campaign, aero=_aero_model(config.rocket, self.base_dir),
-                                           files=_file_digests(config, self.base_dir))  # fmt: skip
-        design = lambda c: None if c.gnc is None else c.gnc.model_dump(exclude={"navigation"})  # noqa: E731
-        if new_aero or design(config) != design(self.config):
-            campaign = _with_gains(campaign)
-        return campaign
-
-
-def _with_gains(campaign: Campaign) -> Campaign:
-    """``campaign`` with its LQI gain schedule and what it was designed from (``campaign/gains.py``), both
-    None without a [gnc] section."""
-    if campaign.config.gnc is None:
-        return dataclasses.replace(campaign, gnc_schedule=None, gnc_inputs=None)
-    from .gains import design_inputs, design_schedule  # gains imports campaign.model, which imports this module
-
-    inputs = design_inputs(campaign)
-    return dataclasses.replace(campaign, gnc_schedule=design_schedule(campaign, inputs), gnc_inputs=inputs)
-
-
-SHOWN_INPUT_LENGTH = 60
-"""Characters of a refused value that an error message shows (a 10 000-character name is not repeated)."""
-
-
-def _shown(value) -> str:
-    text = repr(value)
-    return text if len(text) <= SHOWN_INPUT_LENGTH else f"{text[:SHOWN_INPUT_LENGTH]}... ({len(text)} characters)"
-
-
-def _format_error(error: ValidationError) -> str:
-    first = error.errors()[0]
-    path = ".".join(str(p) for p in first["loc"]) or "(top level)"
-    if first["type"] == "extra_forbidden":
-        return f"{path}: unknown key"
-    if first["type"] == "missing":
-        return f"{path}: missing (required)"
-    message = first["msg"].removeprefix("Value error, ")
-    found = first.get("input")
-    shown = "" if isinstance(found, dict | list) else f" (got {_shown(found)})"
-    return f"{path}: {message}{shown}"
-
-
-def _validate(data: dict) -> CampaignConfig:
-    try:
-        return CampaignConfig.model_validate(data)
-    except ValidationError as e:
-        raise ConfigError(_format_error(e)) from None
-
-
-def _deep_merge(base: dict, override: dict) -> dict:
-    merged = copy.deepcopy(base)
-    for key, value in override.items():
-        if isinstance(value, dict) and isinstance(merged.get(key), dict):
-            merged[key] = _deep_merge(merged[key], value)
-        else:
-            merged[key] = value
-    return merged
-
-
-def preset_rocket(name: str) -> dict:
-    """The rocket table of a built-in preset (``data/rockets/<name>.toml``)."""
-    folder = resources.files("rocketmc") / "data" / "rockets"
-    available = sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml"))
-    if name not in available:  # a name, not a path
-        raise ConfigError(f"rocket.preset: unknown preset {_shown(name)} (available: {', '.join(available)})")
-    return tomllib.loads((folder / f"{name}.toml").read_text())
-
-
-def _resolve_data_file(name: str, base_dir: Path, folder: str, field: str) -> Path:
-    """``name`` beside the campaign, else in the package's ``data/<folder>``."""
-    candidate = base_dir / name
-    builtin = resources.files("rocketmc") / "data" / folder / name
-    try:
-        if candidate.is_file():
-            return candidate
-        if builtin.is_file():
-            return Path(str(builtin))
-        exists = candidate.exists()
-    except OSError as err:  # e.g. a name too long for the file system
-        raise ConfigError(f"{field}: cannot look up {_shown(name)} ({err.strerror})") from None
-    if exists:
-        raise ConfigError(f"{field}: {_shown(name)} is not a file (a folder?)")
-    raise ConfigError(f"{field}: file not found: {_shown(name)} (neither beside the campaign nor built in)")
-
-
-def flatten_numbers(tree, prefix: str = "") -> dict[str, float]:
-    """Numeric leaves (not bools) of nested dicts/lists, keyed by dotted path."""
-    items = tree.items() if isinstance(tree, dict) else enumerate(tree) if isinstance(tree, list) else None
-    if items is None:
-        return {prefix: float(tree)} if isinstance(tree, int | float) and not isinstance(tree, bool) else {}
-    out = {}
-    for key, value in items:
-        out.update(flatten_numbers(value, f"{prefix}.{key}" if prefix else str(key)))
-    return out
-
-
-def _set_path(data: dict, path: str, value: float) -> dict:
-    data = copy.deepcopy(data)
-    *parents, last = path.split(".")
-    node = data
-    for p in parents:
-        node = node[int(p)] if isinstance(node, list) else node[p]
-    if isinstance(node, list):
-        node[int(last)] = value
-    else:
-        node[last] = value
-    return data
-
-
-def _drawable_values(d: Dispersion, nominal_value: float, field: str) -> list[tuple[float, str]]:
-    """The values that bound what ``d`` draws (every valid range is an interval, so they are enough), each
-    with a hint for the error message. ConfigError if a normal's clip range excludes its mean."""
-    if d.dist == "choice":
-        return [(value, "") for value in d.values]
-    if d.dist == "uniform":
-        return [(d.low, ""), (d.high, "")]
-    mean = nominal_value if d.mean is None else d.mean
-    if not ((d.low is None or d.low <= mean) and (d.high is None or mean <= d.high)):
-        of = " (the nominal value, as no mean is given)" if d.mean is None else ""
-        raise ConfigError(f"{field}: the clip range [{d.low}, {d.high}] excludes the mean {mean!r}{of}")
-    reach = NORMAL_REACH_STD * d.std
-    sides = [(d.low, mean - reach, "−", "low"), (d.high, mean + reach, "+", "high")]
-    return [(mean, "")] + [
-        (clip, "") if clip is not None else (unclipped, f" (mean {sign} {NORMAL_REACH_STD:g}·std; clip it with {key})")
-        for clip, unclipped, sign, key in sides
-    ]
-
-
-def fixed_reason(path: str) -> str | None:
-    """Why the number at dotted ``path`` is fixed for the whole campaign (not dispersible), or None."""
-    if path.startswith(FIXED_PER_CAMPAIGN) and not path.startswith(DISPERSIBLE_AERO):
-        return ("fixed for the whole campaign (it defines the body frame or builds the aerodynamic tables); "
-                "disperse rocket.aero.drag_scale or rocket.aero.cl0 instead")  # fmt: skip
-    if path.startswith("avionics.") and path.rstrip("0123456789.").endswith(FIXED_AVIONICS):
-        return "fixed for the whole campaign (a sensor's schedule is set once, and its per-flight spreads are dispersions already)"
-    if path.startswith(FIXED_GNC):
-        return ("fixed for the whole campaign (guidance, the LQI gains and the navigation filters are set once, "
-                "when it loads); only the servos, gnc.servo.*, can be dispersed")  # fmt: skip
-    return None
-
-
-def _check_dispersions(config: CampaignConfig, nominal: dict[str, float]) -> None:
-    """Each dispersion names a dispersible number and every value it can draw passes validation; one a sensor's
-    per-flight spread implies (``sensor_spreads``) is named by that spread, the field the file gives."""
-    data = config.model_dump(exclude={"dispersions"})
-    implied = sensor_spreads(config)
-    for path, d in config.dispersions.items():
-        field = f"dispersions.{path}"
-        if implied.get(path) == d:
-            _check_spread_draws(data, path, d, nominal[path])
-            continue
-        if (reason := fixed_reason(path)) is not None:
-            raise ConfigError(f"{field}: {reason}")
-        if path.startswith("environment.wind.") and config.environment.atmosphere is not None:
-            raise ConfigError(f"{field}: the wind is environment.atmosphere's; disperse "
-                              "environment.atmosphere.wind_rotation_deg or wind_scale instead")  # fmt: skip
-        if path not in nominal:
-            raise ConfigError(f"{field}: not a dispersible number (expected a numeric field of "
-                              f"{'/'.join(DISPERSIBLE_SECTIONS)}, e.g. 'rocket.dry_mass_kg')")  # fmt: skip
-        for value, hint in _drawable_values(d, nominal[path], field):
-            try:
-                CampaignConfig.model_validate(_set_path(data, path, value))
-            except ValidationError as e:
-                raise ConfigError(f"{field}: draws a value {value!r}{hint} that is out of range: "
-                                  f"{_format_error(e)}") from None  # fmt: skip
-
-
-def _check_spread_draws(data: dict, path: str, d: Dispersion, nominal_value: float) -> None:
-    """ConfigError naming the spread (``avionics.<sensor>.<spread>``) if the draws it implies at ``path``
-    (``avionics.<sensor>.<value>.<i>``, normal about the nominal value, unclipped) can leave the value's range."""
-    sensor, target = path.split(".")[1:3]
-    spread = f"avionics.{sensor}.{next(name for name, value in SPREADS.items() if value == target)}"
-    reach = NORMAL_REACH_STD * d.std
-    for sign, value in (("−", nominal_value - reach), ("+", nominal_value + reach)):
-        try:
-            CampaignConfig.model_validate(_set_path(data, path, value))
-        except ValidationError as e:
-            raise ConfigError(f"{spread}: draws {value!r} (the nominal {sign} {NORMAL_REACH_STD:g}·std), out of "
-                              f"range: {_format_error(e)}; lower it, or clip the draws with a dispersion of that "
-                              "path (low, high)") from None  # fmt: skip
-
-
-def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
-    """Validate a campaign from its TOML text; relative files are looked up from ``base_dir``."""
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ConfigError(f"not valid TOML: {e}") from None
-    return campaign_from_dict(raw, base_dir, text)
-
-
-def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") -> Campaign:
-    """Validate a campaign from the tables of a campaign file (e.g. one read with ``tomllib`` and
-    edited); ``text`` is what result files record as the campaign's source."""
-    raw = copy.deepcopy(raw)
-    rocket = raw.get("rocket")
-    if isinstance(rocket, dict) and "preset" in rocket:
-        overrides = {k: v for k, v in rocket.items() if k != "preset"}
-        if not isinstance(rocket["preset"], str):
-            raise ConfigError(f"rocket.preset: expected a string (got {rocket['preset']!r})")
-        raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"]), overrides)
-    config = _validate(raw)
-    _check_geometry(config.rocket)
-
-    path = _resolve_data_file(config.rocket.motor.thrust_curve, base_dir, "motors", "rocket.motor.thrust_curve")
-    try:
-        time_s, thrust_n = read_thrust_curve(path)
-    except ThrustCurveError as e:
-        raise ConfigError(f"rocket.motor.thrust_curve: {e}") from None
-    motor = config.rocket.motor
-    if motor.isp_s is not None:
-        curve_isp = cumulative_impulse(time_s, thrust_n)[-1] / (G0 * motor.propellant_mass_kg)
-        if abs(curve_isp - motor.isp_s) > ISP_TOLERANCE * motor.isp_s:
-            raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
-                              f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
-
-    config = _with_sensor_spreads(config)
-    nominal = _nominal_values(config)
-    _check_dispersions(config, nominal)
-    aero = _aero_model(config.rocket, base_dir)
-    return _with_gains(Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir,
-                                _wind_profile(config, base_dir), _file_digests(config, base_dir),
-                                weather=_weather(config, base_dir)))  # fmt: skip
-
-
-def sensor_ticks(config: CampaignConfig, seconds: float, field: str) -> int:
-    """``seconds`` as a whole number of GNC periods (``simulation.control_dt_s``); ConfigError naming
-    ``field`` if it is not one."""
-    dt = config.simulation.control_dt_s
-    ticks = round(seconds / dt)
-    if abs(ticks * dt - seconds) > 1e-9 * max(seconds, dt):
-        raise ConfigError(f"{field}: {seconds:g} s is not a whole number of GNC periods "
-                          f"(simulation.control_dt_s = {dt:g} s)")  # fmt: skip
-    return ticks
-
-
-def sample_period_ticks(config: CampaignConfig, sensor: str) -> int:
-    """The GNC periods between two samples of ``sensor``; ConfigError unless its rate divides the GNC rate into a
-    divisor of ``SimSettings.block_steps`` (a sensor's noise is drawn a block at a time, for its samples only)."""
-    dt, rate = config.simulation.control_dt_s, getattr(config.avionics, sensor).rate_hz
-    every = round(1.0 / (rate * dt))
-    if every < 1 or abs(every * rate * dt - 1.0) > 1e-9 or SimSettings.block_steps % every:
-        rates = ", ".join(f"{1 / (k * dt):g}" for k in (1, 2, 5, 10))
-        raise ConfigError(f"avionics.{sensor}.rate_hz: {rate:g} Hz does not divide the GNC rate ({1 / dt:g} Hz, "
-                          f"simulation.control_dt_s = {dt:g} s) into a divisor of {SimSettings.block_steps} GNC "
-                          f"periods (the noise blocks): e.g. {rates} Hz")  # fmt: skip
-    return every
-
-
-GEOMETRY_TOLERANCE_M = 1e-9
-"""Slack on the geometry's fits [m]: a fin whose trailing edge is the aft end, computed from positions in
-another origin, may land a rounding error past it."""
-
-
-def _check_geometry(rocket: RocketConfig) -> None:
-    """The build-up's shape can be built: every fin set's and the canards' root chord on the body (from the
-    nose tip to the aft end), the canards clear of every fin set, a boat-tail behind the nose and ending at
-    or before the aft end, narrowing; one line naming the field."""
-    g = rocket.geometry
-    if g is None:
-        return
-    length, eps = g.length_m, GEOMETRY_TOLERANCE_M
-
-    def root(path: str, f: FinSetConfig) -> tuple[float, float]:
-        start = rocket.from_nose(f.position_m)
-        end = start + f.root_chord_m
-        if start < -eps or end > length + eps:
-            raise ConfigError(f"rocket.geometry.{path}.position_m: the root chord spans {start:g} to {end:g} m from "
-                              f"the nose tip, outside the body (0 to length_m = {length:g} m)")  # fmt: skip
-        return start, end
-
-    fins = [(f"fins.{i}", root(f"fins.{i}", f)) for i, f in enumerate(g.fins)]
-    if g.canards is not None:
-        start, end = root("canards", g.canards)
-        for path, (fin_start, fin_end) in fins:
-            if start < fin_end - eps and fin_start < end - eps:
-                raise ConfigError(f"rocket.geometry.canards.position_m: the canards' root chord ({start:g} to {end:g} m "
-                                  f"from the nose tip) overlaps {path}'s ({fin_start:g} to {fin_end:g} m)")  # fmt: skip
-    if (tail := g.boat_tail) is not None:
-        start = rocket.from_nose(tail.position_m)
-        if start < g.nose.length_m - eps or start + tail.length_m > length + eps:
-            raise ConfigError(f"rocket.geometry.boat_tail.position_m: the boat-tail spans {start:g} to "
-                              f"{start + tail.length_m:g} m from the nose tip, not between the nose's end "
-                              f"({g.nose.length_m:g} m) and the aft end ({length:g} m)")  # fmt: skip
-        if tail.aft_diameter_m > g.body_diameter_m:
-            raise ConfigError(f"rocket.geometry.boat_tail.aft_diameter_m: {tail.aft_diameter_m:g} m exceeds the body's "
-                              f"diameter ({g.body_diameter_m:g} m); a boat-tail narrows")  # fmt: skip
-
-
-def _check_avionics(config: CampaignConfig) -> None:
-    """Sensor rates divide the GNC rate, latencies are whole GNC periods, raw-sensor navigation has sensors."""
-    gnc = config.gnc
-    if gnc is not None and gnc.navigation != "truth" and config.avionics is None:
-        raise ConfigError(f"gnc.navigation: '{gnc.navigation}' needs an [avionics] section (the sensors it reads)")
-    if gnc is not None and gnc.navigation == "filters" and gnc.filters.initialisation != "rail":
-        _check_pad_samples(config)
-    for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
-        sample_period_ticks(config, sensor)
-        sensor_ticks(config, getattr(config.avionics, sensor).latency_s, f"avionics.{sensor}.latency_s")
-
-
-def _check_pad_samples(config: CampaignConfig) -> None:
-    """ConfigError unless the motor lights after the filters' pad samples in every flight (the samples at the
-    GNC ticks before ignition)."""
-    pad = config.gnc.filters.pad_samples * config.simulation.control_dt_s
-    path = "rocket.motor.ignition_delay_s"
-    nominal, d = config.rocket.motor.ignition_delay_s, config.dispersions.get(path)
-    earliest = min([nominal] + ([] if d is None else [value for value, _ in _drawable_values(d, nominal, path)]))
-    if earliest < pad:
-        raise ConfigError(f"gnc.filters.initialisation: '{config.gnc.filters.initialisation}' needs "
-                          f"{config.gnc.filters.pad_samples} samples on the "
-                          f"pad ({pad:g} s) before ignition, but {path} can be {earliest:g} s (raise it, lower "
-                          "gnc.filters.pad_samples, or initialise from the 'rail')")  # fmt: skip
-
-
-def _check_faults(config: CampaignConfig) -> None:
-    """Each fault some flight can have acts on a section the campaign has (the servos of [gnc], the sensors of
-    [avionics]), and a bias jump on a sensor with errors (a truth-only sensor has no bias)."""
-    for name in ({} if config.faults is None else config.faults.active()):
-        section = FAULT_SECTIONS[name]
-        if getattr(config, section) is None:
-            acts_on = "the canard servos" if section == "gnc" else "the sensors"
-            raise ConfigError(f"faults.{name}: needs [{section}] ({acts_on} it acts on)")
-        sensor = name.removesuffix("_bias_jump")
-        if sensor != name and getattr(config.avionics, sensor).truth_only:
-            raise ConfigError(f"faults.{name}: avionics.{sensor} is truth_only (no errors, so no bias to jump)")
-
-
-def _with_sensor_spreads(config: CampaignConfig) -> CampaignConfig:
-    """``config`` checked (``_check_avionics``, ``_check_faults``) with its sensors' spreads among its dispersions,
-    the file's own dispersions kept where both name a value."""
-    _check_avionics(config)
-    _check_faults(config)
-    return config.model_copy(update={"dispersions": {**sensor_spreads(config), **config.dispersions}})
-
-
-def sensor_spreads(config: CampaignConfig) -> dict[str, Dispersion]:
-    """The normal dispersions the sensors' per-flight spreads (``SPREADS``) imply, by dotted path: each axis
-    of a value about its nominal value."""
-    spreads = {}
-    for sensor in SENSOR_CONFIGS if config.avionics is not None else ():
-        values = getattr(config.avionics, sensor)
-        for spread, target in SPREADS.items():
-            stds = getattr(values, spread, None)
-            if stds is None:
-                continue
-            nominal = getattr(values, target)
-            for i, std in enumerate(stds if isinstance(stds, list) else [stds] * len(nominal)):
-                if std > 0.0 and i in SPREAD_ELEMENTS.get(target, range(len(nominal))):
-                    spreads[f"avionics.{sensor}.{target}.{i}"] = Dispersion(dist="normal", std=std)
-    return spreads
-
-
-def _nominal_values(config: CampaignConfig) -> dict[str, float]:
-    """Every number of the dispersible sections by dotted path (``Campaign.nominal``); with an
-    [environment.atmosphere], none of [environment.wind]'s (its file brings the wind)."""
-    dump = config.model_dump()
-    if config.environment.atmosphere is not None:
-        del dump["environment"]["wind"]
-    return {k: v for s in DISPERSIBLE_SECTIONS for k, v in flatten_numbers(dump[s], s).items()}
-
-
-def _file_digests(config: CampaignConfig, base_dir: Path) -> dict[str, str]:
-    """SHA-256 of each file the campaign reads, by the field naming it (built-in files too)."""
-    named = {"rocket.motor.thrust_curve": (config.rocket.motor.thrust_curve, "motors")}
-    aero, wind = config.rocket.aero, config.environment.wind
-    if aero.model != "linear" and aero.tables != "buildup" and aero.tables not in BUILTIN_TABLES:
-        named["rocket.aero.tables"] = (aero.tables, "aero")
-    if wind.model == "profile":
-        named["environment.wind.file"] = (wind.file, "wind")
-    if config.environment.atmosphere is not None:
-        named["environment.atmosphere.file"] = (config.environment.atmosphere.file, "weather")
-    return {
-        field: hashlib.sha256(_resolve_data_file(name, base_dir, folder, field).read_bytes()).hexdigest()
-        for field, (name, folder) in named.items()
-    }
-
-
-def _wind_profile(config: CampaignConfig, base_dir: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    wind = config.environment.wind
-    if wind.model != "profile":
-        return None
-    path = _resolve_data_file(wind.file, base_dir, "wind", "environment.wind.file")
-    try:
-        altitude, speed, from_rad = read_wind_profile(path, config.site.altitude_m)
-    except (ValueError, OSError) as err:
-        raise ConfigError(f"environment.wind.file: {err}") from None
-    if speed.max() > MAX_WIND_MPS:
-        raise ConfigError(f"environment.wind.file: {path}: speed_mps reaches {speed.max():g}, "
-                          f"above {MAX_WIND_MPS:g} m/s")  # fmt: skip
-    return altitude, speed, from_rad
-
-
-def _weather(config: CampaignConfig, base_dir: Path) -> Weather | None:
-    """The day's atmosphere at the site (``env.weather.read_weather``), None without [environment.atmosphere]."""
-    atmosphere, field = config.environment.atmosphere, "environment.atmosphere"
-    if atmosphere is None:
-        return None
-    path = _resolve_data_file(atmosphere.file, base_dir, "weather", f"{field}.file")
-    time = None if atmosphere.time_utc is None else datetime.fromisoformat(atmosphere.time_utc)
-    try:
-        weather = read_weather(path, config.site.latitude_deg, config.site.longitude_deg, time, atmosphere.grid)
-    except WeatherError as err:
-        raise ConfigError(f"{field}.{err.field}: {err}") from None
-    if weather.speed_mps.max() > MAX_WIND_MPS:
-        raise ConfigError(f"{field}.file: {path}: the wind reaches {weather.speed_mps.max():g} m/s, "
-                          f"above {MAX_WIND_MPS:g} m/s")  # fmt: skip
-    return weather
-
-
-def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
-    aero = rocket.aero
-    geometry = None if rocket.geometry is None else rocket.geometry.to_geometry(rocket.from_nose)
-    try:
-        if aero.tables == "buildup":
-            tables = build_up_tables(geometry, rocket.from_nose(rocket.reference_point_m))
-        else:
-            references = {
-                k: v for k in ("reference_area_m2", "reference_length_m") if (v := getattr(aero, k)) is not None
-            }  # fmt: skip
-            if aero.moment_reference_m is not None:
-                references["moment_reference_m"] = rocket.from_nose(aero.moment_reference_m)
-            tables = BUILTIN_TABLES[aero.tables]() if aero.tables in BUILTIN_TABLES else load_aero(
-                _resolve_data_file(aero.tables, base_dir, "aero", "rocket.aero.tables"), **references
-            )
-            if geometry is not None:
-                tables = with_canards(tables, geometry)
-        if aero.cd is not None:
-            tables = with_axial_curve(tables, aero.cd_mach, aero.cd)
-    except (ValueError, OSError) as err:
-        raise ConfigError(f"rocket.aero.tables: {err}") from None
-    return tables
-
-
-def _power_on_table(rocket: RocketConfig) -> Table | None:
-    """ΔCA(Mach) while the motor burns: ``cd_power_on − cd`` if given, else the build-up's (the
-    exhaust area taken as the nominal grain's outer diameter) when the tables are built up and no
-    Cd curve replaces them, else None (no power-on effect)."""
-    aero = rocket.aero
-    if aero.cd_power_on is not None:
-        mach, increment = aero.cd_mach, np.subtract(aero.cd_power_on, aero.cd)
-    elif aero.tables == "buildup" and aero.cd is None:
-        geometry = rocket.geometry.to_geometry(rocket.from_nose)
-        mach, increment = power_on_axial_increment(geometry, rocket.motor.grain_outer_diameter_m)
-    else:
-        return None
-    return Table.from_numpy((mach,), np.asarray(increment)[:, None], ("mach",), ("dCA",))
-
-
-def _aero_model(rocket: RocketConfig, base_dir: Path) -> TableAero | LinearAero | None:
-    """The campaign's aerodynamic model with its nominal scalars (``campaign.model`` replaces the
-    dispersible ones per flight), or None for ``model = 'linear'`` (built per flight)."""
-    if rocket.aero.model == "linear":
-        return None
-    table_aero = TableAero.from_tables(_aero_tables(rocket, base_dir), rocket.from_nose(rocket.reference_point_m))
-    table_aero = dataclasses.replace(table_aero, power_on_ca=_power_on_table(rocket))
-    return simplify(table_aero) if rocket.aero.model == "simplified" else table_aero
-
-
-def load_campaign(path: str | Path) -> Campaign:
-    """Read and validate a campaign file."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"campaign file not found: {path}")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise ConfigError("not valid TOML: not UTF-8 text (a binary file?)") from None
-    return parse_campaign(text, path.parent)
