@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..campaign.config import FAULT_SECTIONS
+from ..campaign.schema import FAULT_SECTIONS
 from ..errors import RocketmcError
 from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
 from .results import Run, _table, navigation_warnings
