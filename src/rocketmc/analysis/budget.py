@@ -6,7 +6,7 @@ the filters on perfect sensors, carrying the truth's field), and as two referenc
 (``navigation = "truth"``) and the controller off. Every row has the campaign's seed and N, so realization i meets
 the same winds and draws everything else the same in every row (each dispersion, and each sensor's noise, has its
 own random stream: ``campaign/sampling.py``). Per row: the 95 % landing ellipse's area, its paired ratios to the
-other rows, the navigation and control metrics of ``sim/flight.py`` (medians and 95th percentiles) and the failed
+other rows, the navigation and control metrics of ``sim/outputs.py`` (medians and 95th percentiles) and the failed
 flights.
 
 A source is an entry of ``SOURCES``: a name, a description, the config overrides that switch it off (dotted path
@@ -28,7 +28,7 @@ import numpy as np
 from ..campaign.config import Campaign, CampaignConfig
 from ..campaign.runner import run_chunks
 from ..errors import RocketmcError
-from ..sim.flight import CONTROL_METRICS, NAVIGATION_METRICS
+from ..sim.outputs import CONTROL_METRICS, NAVIGATION_METRICS
 from .ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
 
 LEVEL = 0.95

@@ -7,7 +7,7 @@ vector code, hence the same bits (one unbatched flight differs from the campaign
 impact). Its summary is ``flight_summary`` of the state at the end of the first block of ``block_steps`` periods
 at which the flight is done, where the runner stops it.
 
-Sample k is the state at the start of period k (the first at t = 0 at rest on the rail), with ``sim.flight.loads``
+Sample k is the state at the start of period k (the first at t = 0 at rest on the rail), with ``sim.loads.loads``
 there: the gust and canard deflections of the period starting at that instant, i.e. its first RK4 stage. The
 periods are the flight's own (``control_dt_s``, longer in steady descent under canopy). Positions along the rocket
 (CG, centre of pressure) are distances from the nose tip [m], angles in degrees, everything else SI.
@@ -39,9 +39,10 @@ from ..dynamics.servo import deflection_at
 from ..env import G0
 from ..env.site import latitude_longitude_deg
 from ..files import replacing, replacing_hdf5
-from ..sim.flight import (
-    DEPLOY_TIME_SUFFIX, Metric, Status, flight_done, flight_summary, fly, initial_state, loads, metric, period_gust,
-)  # fmt: skip
+from ..sim.flight import flight_done, fly, initial_state, period_gust
+from ..sim.loads import loads
+from ..sim.outputs import DEPLOY_TIME_SUFFIX, Metric, flight_summary, metric
+from ..sim.state import Status
 from .export import KML_NAMESPACE
 
 OUT_SUFFIXES = (".csv", ".h5")

@@ -12,8 +12,9 @@ import numpy as np
 from ..aero.buildup import MAX_SUBSONIC_MACH
 from ..aero.model import LinearAero
 from ..aero.stability import static_margin_calibers
-from ..sim.flight import OUTSIDE_TABLES_QBAR_FRACTION, mass_properties
+from ..sim.loads import mass_properties
 from ..sim.params import FlightParams
+from ..sim.state import OUTSIDE_TABLES_QBAR_FRACTION
 from .config import Campaign
 from .model import nominal_params
 
@@ -88,7 +89,7 @@ def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: 
     flown) above the tables' Mach axis (values clamped at its edge) or, for built-up tables, above the
     subsonic theory's ``MAX_SUBSONIC_MACH``; ``max_altitude_m`` [m MSL] above the tables' altitude axis;
     ``outside_tables`` flights that flew outside any axis (α, β, Mach, altitude) at more than
-    ``sim.flight.OUTSIDE_TABLES_QBAR_FRACTION`` of their maximum dynamic pressure (status 3's criterion, counted
+    ``sim.state.OUTSIDE_TABLES_QBAR_FRACTION`` of their maximum dynamic pressure (status 3's criterion, counted
     whatever status a flight ended with). NaN maxima (no flight ok) are skipped."""
     aero = campaign.aero if campaign.aero is not None else nominal_params(campaign).rocket.aero
     tables = [aero.table] if isinstance(aero, LinearAero) else [t for t in (aero.body, aero.canard_table) if t]

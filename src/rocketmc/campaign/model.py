@@ -34,7 +34,7 @@ from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
 from ..sim.faults import Faults, GnssOutage, SensorStep, SlowCanard, StuckCanard
-from ..sim.flight import rail_start_n
+from ..sim.events import rail_start_n
 from ..sim.params import Environment, FlightParams, Launch, Rocket
 from .config import Campaign, FiltersConfig, sample_period_ticks, sensor_ticks
 from .sampling import UNIT_FIELDS, realization_key, stream_key

@@ -1,7 +1,10 @@
 """Run a campaign: ``jit(vmap(...))`` over fixed-size chunks of realization indices.
 
-The only place where ``jit`` and ``vmap`` are applied. Every chunk has the same shape (the last one
-is padded with indices past N, whose results are dropped), so one compilation serves the run, and
+Where the campaigns' flights are compiled (``sim`` applies no ``jit`` or ``vmap``): ``jit`` of ``shard_map`` over
+the cores of ``vmap``-ped lanes (``compile_chunk``, ``simulate_queue``). Single flights are compiled elsewhere
+(``bench``, ``campaign.sensor_record``, ``analysis.flight_record``, ``analysis.validation``), and so are host-side
+helpers (``campaign.gains``, ``aero.model``, ``aero.stability``, ``analysis.replay``). Every chunk has the same shape
+(the last one is padded with indices past N, whose results are dropped), so one compilation serves the run, and
 realization ``i`` gives the same bits whatever the chunk size.
 
 Bit-identity needs one more thing: each core's batch is a whole number of SIMD vectors. XLA
@@ -23,7 +26,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..pytree import tree_where
-from ..sim.flight import fly_block, flight_done, flight_summary, initial_state, simulate_one
+from ..sim.flight import fly_block, flight_done, initial_state, simulate_one
+from ..sim.outputs import flight_summary
 from ..sim.params import FlightParams
 from ..sim.params import SimSettings
 from .config import Campaign

@@ -100,7 +100,7 @@ def sensed_triggers(state: Recovery, nav: Navigation, true_height_m, moving, can
     once the estimated vertical velocity has pointed down for ``APOGEE_DESCENDING_TICKS`` ticks after the sensed
     liftoff (``moving``), when the parachutes triggered at apogee (``trigger_altitudes_m`` inf) trigger, at t; the
     navigation's height error against ``true_height_m`` [m] kept while no canopy is out (bool ``canopy``). The
-    altitude triggers fire inside the integration (``sim.flight.update_events``) where the true height plus that
+    altitude triggers fire inside the integration (``sim.events.update_events``) where the true height plus that
     error crosses their altitude. Returns the new state and the trigger times [s] (``trigger_times``, inf before)."""
     descending = moving & (nav.v_n.z > 0.0)
     ticks = jnp.where(descending, state.descending_ticks + 1, 0)
@@ -211,7 +211,7 @@ def truth(body: RigidBodyState) -> tuple[Navigation, jnp.ndarray]:
 
 
 def control_summary(state: GncState) -> dict:
-    """The controller's per-flight outputs (``sim.flight.CONTROL_METRICS``); NaN where it never acted."""
+    """The controller's per-flight outputs (``sim.outputs.CONTROL_METRICS``); NaN where it never acted."""
     acted = state.active_time > 0.0
     per_active = 1.0 / jnp.where(acted, state.active_time, 1.0)
     return {

@@ -347,7 +347,7 @@ DIVERGED_MEANING = (
     f"then, or a filter's NEES averaged over that time above {DIVERGED_NEES:g}); 0: it did not. Kept in the ellipse: "
     "the flight flew so"
 )
-"""``navigation_diverged``'s meaning (``sim.flight.NAVIGATION_METRICS``)."""
+"""``navigation_diverged``'s meaning (``sim.outputs.NAVIGATION_METRICS``)."""
 
 
 def navigation_diverged(summary: dict, burnout_speed_mps) -> jnp.ndarray:
@@ -360,7 +360,7 @@ def navigation_diverged(summary: dict, burnout_speed_mps) -> jnp.ndarray:
 
 
 def navigation_summary(state: FilterState, burnout_speed_mps) -> dict:
-    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came, but
+    """The filters' per-flight outputs (``sim.outputs.NAVIGATION_METRICS``); NaN where their span never came, but
     ``navigation_diverged`` (0 or 1; ``burnout_speed_mps``: the true speed at burnout [m/s], NaN before)."""
     e = state.errors
 
