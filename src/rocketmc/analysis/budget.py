@@ -28,6 +28,7 @@ import numpy as np
 from ..campaign.config import Campaign, CampaignConfig
 from ..campaign.runner import run_chunks
 from ..errors import RocketmcError
+from ..gnc.navigation import NavigationMode
 from ..sim.outputs import CONTROL_METRICS, NAVIGATION_METRICS
 from .ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
 
@@ -66,13 +67,13 @@ def sensor_read(config: CampaignConfig, sensor: str) -> bool:
     """Whether the controller's navigation reads ``sensor`` (gnc/navigation.py): on raw sensors ("sensors") the
     gyroscope, the GNSS, the accelerometer (liftoff) and the canard feedback (the LQI's actuator states); on the
     filters also the magnetometer and, with its update on, the barometer."""
-    navigation = config.gnc.navigation
+    navigation = NavigationMode(config.gnc.navigation)
     if sensor in ("accelerometer", "gyroscope", "gnss", "canard_feedback"):
-        return navigation in ("sensors", "filters")
+        return navigation is not NavigationMode.TRUTH
     if sensor == "magnetometer":
-        return navigation == "filters"
+        return navigation is NavigationMode.FILTERS
     if sensor == "barometer":
-        return navigation == "filters" and config.gnc.filters.position.barometer
+        return navigation is NavigationMode.FILTERS and config.gnc.filters.position.barometer
     return False
 
 
@@ -154,7 +155,7 @@ def check_campaign(campaign: Campaign) -> None:
     config = campaign.config
     if config.gnc is None:
         raise BudgetError("no [gnc] section: the budget needs a closed-loop campaign (navigation 'filters' or 'sensors')")
-    if config.gnc.navigation == "truth":
+    if NavigationMode(config.gnc.navigation) is NavigationMode.TRUTH:
         raise BudgetError("gnc.navigation is 'truth': no navigation errors to budget (use 'filters' or 'sensors')")
     if config.n_realizations < MIN_REALIZATIONS:
         raise BudgetError(f"{config.n_realizations} realizations: the ellipses need at least {MIN_REALIZATIONS}")

@@ -12,6 +12,7 @@ import numpy as np
 from ..aero.buildup import MAX_SUBSONIC_MACH
 from ..aero.model import LinearAero
 from ..aero.stability import static_margin_calibers
+from ..gnc.navigation import NavigationMode
 from ..sim.loads import mass_properties
 from ..sim.params import FlightParams
 from ..sim.state import OUTSIDE_TABLES_QBAR_FRACTION
@@ -65,7 +66,7 @@ def calibration_warnings(campaign: Campaign) -> list[str]:
     the magnetometer above ``UNCALIBRATED_FIELD_OFFSET_UT``, the gyroscope above ``UNCALIBRATED_GYRO_BIAS_DEG_S``
     (none without [gnc] navigation = "filters", or for a truth-only sensor)."""
     cfg = campaign.config
-    if cfg.gnc is None or cfg.gnc.navigation != "filters" or cfg.avionics is None:
+    if cfg.gnc is None or NavigationMode(cfg.gnc.navigation) is not NavigationMode.FILTERS or cfg.avionics is None:
         return []
     mag, gyro = cfg.avionics.magnetometer, cfg.avionics.gyroscope
     spreads = {

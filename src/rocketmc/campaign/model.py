@@ -25,7 +25,7 @@ from ..env.weather import geometric_altitude
 from ..gnc.control import GAIN_NAMES, GncParams
 from ..gnc.attitude_filter import AttitudeTuning
 from ..gnc.guidance import GuidanceParams
-from ..gnc.navigation import FilterParams
+from ..gnc.navigation import FilterParams, NavigationMode
 from ..gnc.position_filter import PositionTuning
 from ..math import Quat, Vec3
 from ..math.table import Table
@@ -218,9 +218,10 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
         table = Table.from_numpy((schedule.speeds, schedule.altitudes), gains, ("speed", "altitude"), GAIN_NAMES)
     else:
         table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
-    filters = filter_params(campaign) if gnc.navigation == "filters" else None
-    rail = (None, None) if gnc.navigation == "truth" else nominal_rail(campaign)
-    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation, filters, *rail)
+    navigation = NavigationMode(gnc.navigation)
+    filters = filter_params(campaign) if navigation is NavigationMode.FILTERS else None
+    rail = (None, None) if navigation is NavigationMode.TRUTH else nominal_rail(campaign)
+    return GncParams(servo, guidance, table, gnc.control.anti_windup, navigation, filters, *rail)
 
 
 def nominal_rail(campaign: Campaign) -> tuple[Quat, Vec3]:

@@ -1,5 +1,6 @@
-"""Navigation from the avionics bus: ``navigation = "sensors"``, raw sensors, and ``"filters"``, the MEKF
-(``attitude_filter``) and the position/velocity Kalman filter (``position_filter``).
+"""Navigation from the avionics bus (``NavigationMode``): ``SENSORS`` (``navigation = "sensors"``), raw sensors,
+and ``FILTERS`` (``"filters"``), the MEKF (``attitude_filter``) and the position/velocity Kalman filter
+(``position_filter``).
 
 Raw sensors: body rates from the gyroscope, the launch attitude propagated by the gyroscope's rates (no
 correction: its bias and noise integrate), position and velocity from the GNSS, held between fixes (zero
@@ -15,6 +16,7 @@ solution (the thesis fed the a-priori one forward, a tick late). Frames: NED fro
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 
 import jax.numpy as jnp
@@ -33,6 +35,17 @@ from .position_filter import (
     PositionEstimate, PositionTuning, altitude_nis, altitude_update, gnss_nis, gnss_update, initial_position, position_nees,
     propagate_position,
 )  # fmt: skip
+
+
+class NavigationMode(enum.Enum):
+    """What the controller reads (``gnc.control.navigate``); the value is the campaign's [gnc] ``navigation``:
+    TRUTH, the true state; SENSORS, the raw sensors (``dead_reckoning``); FILTERS, the MEKF and the
+    position/velocity Kalman filter on the bus (``filter_step``)."""
+
+    TRUTH = "truth"
+    SENSORS = "sensors"
+    FILTERS = "filters"
+
 
 LIFTOFF_SPECIFIC_FORCE_MPS2 = 2.0 * G0
 """Liftoff is sensed once the accelerometer reads more than this along the rocket's axis: at rest on the rail

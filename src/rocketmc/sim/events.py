@@ -37,9 +37,9 @@ def update_events(
 ) -> Events:
     """Detect the events inside the step ``[t0, t0 + h]`` from ``b0`` to ``b1`` and interpolate them.
 
-    start_n: ``rail_start_n(p)``, passed in so that it is computed once per flight; sensed: with
-    ``sensed_recovery(p)``, (the navigation's held height error [m], whether it has sensed apogee (bool)) from
-    ``gnc.control.Recovery``, else None (the true apogee and height trigger the parachutes).
+    start_n: ``rail_start_n(p)``, passed in so that it is computed once per flight; sensed: navigating from the
+    sensors (the GNC state's ``gnc.control.Recovery``), the navigation's held height error [m] and whether it has
+    sensed apogee (bool), else None (the true apogee and height trigger the parachutes).
     """
     rail = p.launch.rail_direction_n
     motor = p.rocket.motor
@@ -113,9 +113,3 @@ def update_events(
         jnp.maximum(ev.max_mach, diag.mach), jnp.maximum(ev.max_qbar, diag.qbar),
         jnp.maximum(ev.max_qbar_outside_tables, diag.qbar_outside_tables), ev.non_finite,
     )  # fmt: skip
-
-
-def sensed_recovery(p: FlightParams) -> bool:
-    """Whether the parachutes are triggered by the navigation at the GNC ticks (``gnc.control.sensed_triggers``): a
-    controller navigating from the sensors; else by the true apogee and height (``update_events``). Static."""
-    return p.gnc is not None and p.gnc.navigation != "truth"

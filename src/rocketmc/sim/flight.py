@@ -21,15 +21,11 @@ from ..dynamics import RigidBodyState
 from ..dynamics.rigid_body import normalize_attitude
 from ..dynamics.servo import deflection_at, end_of_period
 from ..env import advance_turbulence, gust_n, initial_turbulence, turbulence_noise, turbulence_scales
-from ..gnc.control import GncState, gnc_step, initial_gnc, sensed_triggers, truth
-from ..gnc.guidance import guidance_active
-from ..gnc.navigation import bus_measurements, dead_reckoning, filter_step, liftoff_sensed, track_errors
+from ..gnc.control import gnc_step, initial_gnc, navigate, track_navigation
 from ..math import Vec3, rk4_step
-from ..sensors.avionics import (
-    avionics_noise, gyroscope_bias_b, initial_avionics, sense, sense_acceleration, specific_force_b,
-)  # fmt: skip
+from ..sensors.avionics import avionics_noise, initial_avionics, sense, sense_acceleration, specific_force_b
 from ..pytree import tree_where
-from .events import rail_start_n, sensed_recovery, update_events
+from .events import rail_start_n, update_events
 from .faults import faulty_servos, faulty_sensors
 from .loads import derivatives, mass_properties
 from .outputs import flight_summary
@@ -108,7 +104,7 @@ def control_step(
     h = period / settings.substeps
     turbulence = p.environment.turbulence
     mean_wind_n, scales, gust = period_gust(p, state)
-    recovery = state.gnc.recovery if sensed_recovery(p) else None
+    recovery = None if state.gnc is None else state.gnc.recovery
     sensed = None if recovery is None else (recovery.height_error_m, jnp.isfinite(recovery.apogee_time))
 
     def rhs(t, y, events):
@@ -156,7 +152,7 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     noise: the period's ``StepNoise``; canard_command: open-loop deflections, a function of time [s]
     returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when ``p.gnc`` is set:
     guidance and control at the period start, the servos' response inside it; navigating from the sensors, the
-    LQI reads the canard feedback and the parachutes trigger on the navigation, ``sensed_recovery``)."""
+    LQI reads the canard feedback and the parachutes trigger on the navigation: ``gnc.control.navigate``)."""
     period = control_period(p, settings, state)
     sensing = period <= settings.control_dt_s  # the sensors sample in GNC periods only, not in long descent ones
     if p.gnc is None:
@@ -170,31 +166,23 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
         raise ValueError("canard_command flies open loop: it needs a flight without a controller (p.gnc None)")
     servo_params, t0 = p.gnc.servo, state.t
     state = start = _sensed(p, state, state.gnc.servo.deflection_rad, sensing, noise)
-    canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in state.events.chute_trigger_times], False)
-    feedback = None
-    if p.gnc.navigation == "truth":
-        nav, moving = truth(state.body)
-    else:
-        bus = state.avionics.bus
-        # liftoff latched: after burnout the accelerometer reads less than the 2 g that sensed it
-        moving = liftoff_sensed(p.avionics, bus) | jnp.isfinite(state.gnc.liftoff_time)
-        if p.gnc.navigation == "sensors":
-            nav, navigation = dead_reckoning(p.avionics, state.gnc.navigation, bus, t0)
-        else:
-            measured = bus_measurements(p.avionics, bus)
-            nav, navigation = filter_step(p.gnc.filters, state.gnc.navigation, measured, t0, moving, canopy)
-        recovery, triggers = sensed_triggers(state.gnc.recovery, nav, -state.body.r_n.z, moving, canopy, t0,
-                                             [chute.trigger_altitude_agl_m for chute in p.rocket.parachutes],
-                                             state.events.chute_trigger_times)  # fmt: skip
-        canopy = functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in triggers], False)
-        events = dataclasses.replace(state.events, chute_trigger_times=triggers)
-        gnc = dataclasses.replace(state.gnc, navigation=navigation, recovery=recovery)
-        state = dataclasses.replace(state, gnc=gnc, events=tree_where(done(state), state.events, events))
-        feedback = jnp.where(bus.canard_feedback.valid, bus.canard_feedback.value, 0.0)  # the servos' sensed positions
+    canopy = _canopy(state.events.chute_trigger_times)
+    navigated = navigate(p.gnc, p.avionics, state.gnc, state.body, state.avionics, t0, canopy,
+                         [chute.trigger_altitude_agl_m for chute in p.rocket.parachutes],
+                         state.events.chute_trigger_times)  # fmt: skip
+    nav, events = navigated.solution, state.events
+    if navigated.trigger_times is not None:
+        canopy = _canopy(navigated.trigger_times)
+        triggered = dataclasses.replace(events, chute_trigger_times=navigated.trigger_times)
+        events = tree_where(done(state), events, triggered)
+    state = dataclasses.replace(state, gnc=navigated.state, events=events)
     altitude_msl = p.environment.site_altitude_m - nav.r_n.z
-    gnc = gnc_step(p.gnc, state.gnc, nav, moving, t0, settings.control_dt_s, altitude_msl, canopy, feedback)
-    if p.gnc.navigation == "filters":
-        gnc = dataclasses.replace(gnc, navigation=_tracked(p, settings, state, gnc, canopy))
+    gnc = gnc_step(p.gnc, state.gnc, nav, navigated.moving, t0, settings.control_dt_s, altitude_msl, canopy,
+                   navigated.feedback_rad)  # fmt: skip
+    body = state.body
+    ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
+    gnc = track_navigation(p.gnc, gnc, t0, settings.control_dt_s, canopy, body, _avionics_at(p, t0), state.avionics,
+                           ascent, t0 >= events.burnout_time, t0 >= events.apogee_time)  # fmt: skip
     held = gnc.servo
     if p.faults is not None and p.faults.servos:
         servo_params, held = faulty_servos(p.faults, servo_params, held, t0)
@@ -206,17 +194,9 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     return _accelerometer(p, start, state, first, sensing, noise)
 
 
-def _tracked(p: FlightParams, settings: SimSettings, state: FlightState, gnc: GncState, canopy):
-    """The filters' state of ``gnc`` with its errors against the truth of ``state`` at the period start
-    (``track_errors``): the window is the controller's active time (the guidance window from the sensed liftoff, no
-    parachute), the ascent from the true first motion to apogee."""
-    body, events, dt = state.body, state.events, settings.control_dt_s
-    window = guidance_active(p.gnc.guidance, state.t - gnc.liftoff_time) & ~canopy
-    ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
-    return track_errors(gnc.navigation, body.q_nb, body.r_n, body.v_n,
-                        gyroscope_bias_b(_avionics_at(p, state.t), state.avionics),
-                        jnp.where(window, dt, 0.0), jnp.where(ascent, dt, 0.0), state.t >= events.burnout_time,
-                        state.t >= events.apogee_time)  # fmt: skip
+def _canopy(trigger_times):
+    """Whether a parachute has been triggered by now (bool): one of ``trigger_times`` [s] finite."""
+    return functools.reduce(jnp.logical_or, [jnp.isfinite(t) for t in trigger_times], False)
 
 
 def _avionics_at(p: FlightParams, t):

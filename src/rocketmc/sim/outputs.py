@@ -8,8 +8,8 @@ from typing import NamedTuple
 import jax.numpy as jnp
 
 from ..env.atmosphere import MAX_ALTITUDE_M
-from ..gnc.control import control_summary
-from ..gnc.navigation import DIVERGED_MEANING, navigation_summary
+from ..gnc.control import gnc_summary
+from ..gnc.navigation import DIVERGED_MEANING
 from .params import FlightParams
 from .state import OUTSIDE_TABLES_QBAR_FRACTION, FlightState, Status
 
@@ -116,10 +116,9 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
         summary[chute.name + DEPLOY_TIME_SUFFIX] = when(trigger_time, trigger_time + chute.delay_s)
     failed = []
     if state.gnc is not None:
-        summary.update(control_summary(state.gnc))
-    if p.gnc is not None and p.gnc.navigation == "filters":
-        summary.update(navigation_summary(state.gnc.navigation, summary["burnout_speed_mps"]))
-        failed = [state.gnc.navigation.failed]
+        closed_loop, navigation_failed = gnc_summary(p.gnc, state.gnc, summary["burnout_speed_mps"])
+        summary.update(closed_loop)
+        failed = [] if navigation_failed is None else [navigation_failed]
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
     status = jnp.select(
