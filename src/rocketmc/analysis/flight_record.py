@@ -210,7 +210,7 @@ def _series(campaign: Campaign, states, samples, summary) -> tuple[pd.DataFrame,
         "mach": (air.mach, "1", "Mach number"),
         "dynamic_pressure": (air.qbar, "Pa", "dynamic pressure ½ρV²"),
         "density": (air.density, "kg/m^3", "air density (the campaign's atmosphere)"),
-        "thrust": (f.thrust, "N", "motor thrust along the body axis"),
+        "thrust": (f.thrust_n, "N", "motor thrust along the body axis"),
         **{f"aero_force_{a}": (getattr(f.aero_force_b, a), "N", f"aerodynamic force, body {a} (FRD)") for a in "xyz"},
         **{f"chute_force_{n}": (getattr(f.chute_force_n, a), "N", f"parachutes' force, {n}")
            for a, n in zip("xyz", ("north", "east", "down"))},

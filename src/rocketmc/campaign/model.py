@@ -206,9 +206,9 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
     rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
     guidance = GuidanceParams(
         apogee_m=jnp.asarray(ref.apogee_m), t0_s=jnp.asarray(g.t0_s), flight_path_angle_rad=rad(ref.flight_path_angle_deg),
-        heading_rad=rad(ref.heading_deg), gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s),
-        min_speed=jnp.asarray(g.min_speed_mps), roll_gain=jnp.asarray(g.roll_gain),
-        roll_heading_rad=rad(ref.roll_heading_deg), roll_rate_limit=rad(g.roll_rate_limit_deg_s),
+        heading_rad=rad(ref.heading_deg), gain=jnp.asarray(g.gain), rate_limit_rad_s=rad(g.rate_limit_deg_s),
+        min_speed_mps=jnp.asarray(g.min_speed_mps), roll_gain=jnp.asarray(g.roll_gain),
+        roll_heading_rad=rad(ref.roll_heading_deg), roll_rate_limit_rad_s=rad(g.roll_rate_limit_deg_s),
         integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
         window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
     )  # fmt: skip

@@ -39,7 +39,7 @@ class Loads(NamedTuple):
 
     mass: MassProperties
     air: AirData
-    thrust: jnp.ndarray
+    thrust_n: jnp.ndarray
     aero_force_b: Vec3
     chute_force_n: Vec3
     moment_b: Vec3
@@ -90,7 +90,7 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad] and a
     turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind."""
     f = loads(t, body, p, deflections, gust_n, events)
-    force_b = f.aero_force_b + Vec3(f.thrust, 0.0, 0.0)
+    force_b = f.aero_force_b + Vec3(f.thrust_n, 0.0, 0.0)
     free = rigid_body_derivatives(body, f.mass, force_b, f.chute_force_n, f.moment_b, G0)
 
     # On the rail: motion along it only, no rotation, no sliding back down before liftoff.
