@@ -29,7 +29,7 @@ import jax.numpy as jnp  # noqa: E402
 
 from rocketmc.campaign import load_campaign, with_overrides  # noqa: E402
 from rocketmc.campaign.runner import realization_params, sim_settings  # noqa: E402
-from rocketmc.sim import flight  # noqa: E402
+from rocketmc.sim import events, flight  # noqa: E402
 
 
 def computations(hlo_text: str) -> dict[str, str]:
@@ -77,7 +77,7 @@ def main() -> None:
     def steps(params, state):
         def one(p, s):
             noise = jax.tree_util.tree_map(lambda x: x[0], flight.block_noise(p, jnp.uint32(0), 1))
-            step = lambda s, _: (flight.step(p, settings, flight.rail_start_n(p), s, noise), None)  # noqa: E731
+            step = lambda s, _: (flight.step(p, settings, events.rail_start_n(p), s, noise), None)  # noqa: E731
             return jax.lax.scan(step, s, None, args.steps)[0]
 
         return jax.vmap(one)(params, state)

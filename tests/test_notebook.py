@@ -10,7 +10,7 @@ import pandas as pd
 from nbclient import NotebookClient
 
 from rocketmc.analysis import load_run
-from rocketmc.sim.flight import CONTROL_METRICS
+from rocketmc.sim.outputs import CONTROL_METRICS
 
 REPO = Path(__file__).resolve().parents[1]
 N = 64

@@ -39,7 +39,7 @@ from . import PRECISION
 from .analysis.ellipse import confidence_ellipse
 from .campaign import load_campaign, run_chunks, with_overrides
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings
-from .sim.flight import Status
+from .sim.state import Status
 
 DEFAULT_CAMPAIGN = Path(str(resources.files("rocketmc") / "data" / "campaigns" / "lynx_nominal.toml"))
 MODELS = ("simplified", "interpolated")

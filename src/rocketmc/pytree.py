@@ -1,7 +1,7 @@
 """One rule for parameter and state containers (see docs/conventions.md).
 
 Every container is a frozen dataclass registered as a JAX pytree. Array-valued fields are
-*dynamic*: they can be batched by ``vmap`` and dispersed. Python ints, bools, strings and tuples
+*dynamic*: they can be batched by ``vmap`` and dispersed. Python ints, bools, strings, enumerations and tuples
 that set shapes or choose code paths are *static*: mark them ``static_field()``; changing one
 recompiles.
 """

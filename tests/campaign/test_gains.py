@@ -27,7 +27,8 @@ from rocketmc.gnc.design import (
 )  # fmt: skip
 from rocketmc.gnc.guidance import Navigation, rate_command, reference_direction
 from rocketmc.math import Quat, Vec3
-from rocketmc.sim.flight import derivatives, initial_state
+from rocketmc.sim.flight import initial_state
+from rocketmc.sim.loads import derivatives
 
 from ..conftest import CAMPAIGNS
 
@@ -149,7 +150,7 @@ def test_controller_and_sensors_added_at_once():
 
 def shifted_rate_jacobian(raw: dict, speed: float, height: float):
     """(A rows v, w, p, q, r of the plant the campaign designs from, the same rows by central differences
-    of the flight's own right-hand side ``sim.flight.derivatives``) at axial speed [m/s] and height above
+    of the flight's own right-hand side ``sim.loads.derivatives``) at axial speed [m/s] and height above
     the pad [m], coasting (after burnout) in calm air; columns v, w, p, q, r, u_y, u_p, u_r."""
     campaign = campaign_from_dict({**raw, "environment": {}, "dispersions": {}}, CAMPAIGNS)  # no wind
     inputs = campaign.gnc_inputs

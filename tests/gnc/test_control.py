@@ -191,7 +191,7 @@ def test_parachutes_trigger_on_the_navigation_solution():
     """``sensed_triggers``: apogee once the estimated vertical velocity has pointed down for
     APOGEE_DESCENDING_TICKS consecutive ticks after liftoff (a shorter run of downward noise resets the count;
     no apogee before liftoff), the drogue (trigger altitude inf) at that tick; the main (an altitude) is left to the
-    integration (``sim.flight.update_events``); the navigation's height error is kept until a canopy is out, then
+    integration (``sim.events.update_events``); the navigation's height error is kept until a canopy is out, then
     held."""
     altitudes = (jnp.asarray(jnp.inf), jnp.asarray(350.0))
     state = control.Recovery(jnp.asarray(0, jnp.int32), jnp.asarray(jnp.inf), jnp.asarray(0.0))

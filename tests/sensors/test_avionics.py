@@ -19,7 +19,8 @@ from rocketmc.env.atmosphere import G0
 from rocketmc.env.magnetic import site_field_ned
 from rocketmc.math import Quat, Vec3
 from rocketmc.sensors.avionics import specific_force_b
-from rocketmc.sim.flight import fly, rail_start_n
+from rocketmc.sim.events import rail_start_n
+from rocketmc.sim.flight import fly
 
 from ..conftest import CAMPAIGNS
 

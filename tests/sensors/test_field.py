@@ -22,7 +22,8 @@ from rocketmc.campaign.model import filter_params
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.env.atmosphere import G0
 from rocketmc.env.magnetic import igrf_site_field_gradient, site_field_ned
-from rocketmc.sim.flight import fly, rail_start_n
+from rocketmc.sim.events import rail_start_n
+from rocketmc.sim.flight import fly
 
 from ..conftest import CAMPAIGNS
 

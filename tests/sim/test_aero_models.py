@@ -9,7 +9,8 @@ from rocketmc.aero import LinearAero, TableAero
 from rocketmc.campaign import with_overrides
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
-from rocketmc.sim.flight import Status, simulate_one
+from rocketmc.sim.flight import simulate_one
+from rocketmc.sim.state import Status
 
 
 def test_interpolated_and_simplified_apogees_within_2_percent(lynx_campaign):

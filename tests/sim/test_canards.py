@@ -40,7 +40,8 @@ from rocketmc.aero.model import table_coefficients
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.env import isa
 from rocketmc.math import Vec3
-from rocketmc.sim.flight import fly, mass_properties
+from rocketmc.sim.flight import fly
+from rocketmc.sim.loads import mass_properties
 
 N_PERIODS = 500  # 10 s at 0.02 s: rail, burn (to ~3.6 s) and 6 s of coast, far below apogee (~25 s)
 U = 0.02  # virtual command [rad] (1.1°): small enough for the linear model, large against Cl0 = −0.03

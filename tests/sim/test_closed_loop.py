@@ -22,7 +22,8 @@ from rocketmc.campaign import campaign_from_dict
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.gnc.guidance import reference_direction
-from rocketmc.sim.flight import flight_summary, fly
+from rocketmc.sim.flight import fly
+from rocketmc.sim.outputs import flight_summary
 
 from ..conftest import CAMPAIGNS
 

@@ -24,19 +24,12 @@ from rocketmc.dynamics import RigidBodyState
 from rocketmc.env import G0, isa
 from rocketmc.math import Vec3
 from rocketmc.math.table import Table
-from rocketmc.sim.flight import (
-    METRICS,
-    Status,
-    derivatives,
-    flight_summary,
-    fly,
-    initial_state,
-    mass_properties,
-    metric,
-    rail_start_n,
-    simulate_one,
-)
+from rocketmc.sim.events import rail_start_n
+from rocketmc.sim.flight import fly, initial_state, simulate_one
+from rocketmc.sim.loads import derivatives, mass_properties
+from rocketmc.sim.outputs import METRICS, flight_summary, metric
 from rocketmc.sim.params import SimSettings
+from rocketmc.sim.state import Status
 
 N_PERIODS = 3000  # control periods flown by `fly`: past every landing (~1650 periods: 0.02 s up, up to 0.25 s under canopy)
 N_BATCH = 3  # realizations compared under vmap and one at a time

@@ -26,7 +26,10 @@ from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.gnc.attitude_filter import attitude_error_b
 from rocketmc.gnc.guidance import reference_direction
 from rocketmc.sensors.avionics import gyroscope_bias_b
-from rocketmc.sim.flight import Status, flight_summary, fly, initial_state, rail_start_n
+from rocketmc.sim.events import rail_start_n
+from rocketmc.sim.flight import fly, initial_state
+from rocketmc.sim.outputs import flight_summary
+from rocketmc.sim.state import Status
 
 from ..conftest import CAMPAIGNS
 

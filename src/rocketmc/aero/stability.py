@@ -69,6 +69,6 @@ def centre_of_pressure_x_m(aero: TableAero | LinearAero, mach: float, altitude_m
 def static_margin_calibers(aero: TableAero | LinearAero, cg_x_m: float, mach: float, altitude_m: float = 0.0) -> float:
     """Static margin [calibers]: (x_cg − x_cp)/d, the centre of mass ahead of the centre of pressure by that
     many reference lengths d; positive is statically stable. ``cg_x_m``: body-frame x of the centre of mass
-    [m, from the reference point, positive toward the nose] (``sim.flight.mass_properties(p, t).cg_x``);
+    [m, from the reference point, positive toward the nose] (``sim.loads.mass_properties(p, t).cg_x``);
     ``mach``, ``altitude_m`` [m MSL]: where the slopes are read (``centre_of_pressure_x_m``)."""
     return (cg_x_m - centre_of_pressure_x_m(aero, mach, altitude_m)) / float(aero.reference_length_m)

@@ -6,7 +6,7 @@ the filters on perfect sensors, carrying the truth's field), and as two referenc
 (``navigation = "truth"``) and the controller off. Every row has the campaign's seed and N, so realization i meets
 the same winds and draws everything else the same in every row (each dispersion, and each sensor's noise, has its
 own random stream: ``campaign/sampling.py``). Per row: the 95 % landing ellipse's area, its paired ratios to the
-other rows, the navigation and control metrics of ``sim/flight.py`` (medians and 95th percentiles) and the failed
+other rows, the navigation and control metrics of ``sim/outputs.py`` (medians and 95th percentiles) and the failed
 flights.
 
 A source is an entry of ``SOURCES``: a name, a description, the config overrides that switch it off (dotted path
@@ -31,7 +31,8 @@ from ..campaign.record import Campaign
 from ..campaign.runner import run_chunks
 from ..campaign.schema import CampaignConfig
 from ..errors import RocketmcError
-from ..sim.flight import CONTROL_METRICS, NAVIGATION_METRICS
+from ..gnc.navigation import NavigationMode
+from ..sim.outputs import CONTROL_METRICS, NAVIGATION_METRICS
 from .ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
 
 LEVEL = 0.95
@@ -69,13 +70,13 @@ def sensor_read(config: CampaignConfig, sensor: str) -> bool:
     """Whether the controller's navigation reads ``sensor`` (gnc/navigation.py): on raw sensors ("sensors") the
     gyroscope, the GNSS, the accelerometer (liftoff) and the canard feedback (the LQI's actuator states); on the
     filters also the magnetometer and, with its update on, the barometer."""
-    navigation = config.gnc.navigation
+    navigation = NavigationMode(config.gnc.navigation)
     if sensor in ("accelerometer", "gyroscope", "gnss", "canard_feedback"):
-        return navigation in ("sensors", "filters")
+        return navigation is not NavigationMode.TRUTH
     if sensor == "magnetometer":
-        return navigation == "filters"
+        return navigation is NavigationMode.FILTERS
     if sensor == "barometer":
-        return navigation == "filters" and config.gnc.filters.position.barometer
+        return navigation is NavigationMode.FILTERS and config.gnc.filters.position.barometer
     return False
 
 
@@ -157,7 +158,7 @@ def check_campaign(campaign: Campaign) -> None:
     config = campaign.config
     if config.gnc is None:
         raise BudgetError("no [gnc] section: the budget needs a closed-loop campaign (navigation 'filters' or 'sensors')")
-    if config.gnc.navigation == "truth":
+    if NavigationMode(config.gnc.navigation) is NavigationMode.TRUTH:
         raise BudgetError("gnc.navigation is 'truth': no navigation errors to budget (use 'filters' or 'sensors')")
     if config.n_realizations < MIN_REALIZATIONS:
         raise BudgetError(f"{config.n_realizations} realizations: the ellipses need at least {MIN_REALIZATIONS}")

@@ -7,7 +7,7 @@ vector code, hence the same bits (one unbatched flight differs from the campaign
 impact). Its summary is ``flight_summary`` of the state at the end of the first block of ``block_steps`` periods
 at which the flight is done, where the runner stops it.
 
-Sample k is the state at the start of period k (the first at t = 0 at rest on the rail), with ``sim.flight.loads``
+Sample k is the state at the start of period k (the first at t = 0 at rest on the rail), with ``sim.loads.loads``
 there: the gust and canard deflections of the period starting at that instant, i.e. its first RK4 stage. The
 periods are the flight's own (``control_dt_s``, longer in steady descent under canopy). Positions along the rocket
 (CG, centre of pressure) are distances from the nose tip [m], angles in degrees, everything else SI.
@@ -39,9 +39,10 @@ from ..dynamics.servo import deflection_at
 from ..env import G0
 from ..env.site import latitude_longitude_deg
 from ..files import replacing, replacing_hdf5
-from ..sim.flight import (
-    DEPLOY_TIME_SUFFIX, Metric, Status, flight_done, flight_summary, fly, initial_state, loads, metric, period_gust,
-)  # fmt: skip
+from ..sim.flight import flight_done, fly, initial_state, period_gust
+from ..sim.loads import loads
+from ..sim.outputs import DEPLOY_TIME_SUFFIX, Metric, flight_summary, metric
+from ..sim.state import Status
 from .export import KML_NAMESPACE
 
 OUT_SUFFIXES = (".csv", ".h5")
@@ -209,7 +210,7 @@ def _series(campaign: Campaign, states, samples, summary) -> tuple[pd.DataFrame,
         "mach": (air.mach, "1", "Mach number"),
         "dynamic_pressure": (air.qbar, "Pa", "dynamic pressure ½ρV²"),
         "density": (air.density, "kg/m^3", "air density (the campaign's atmosphere)"),
-        "thrust": (f.thrust, "N", "motor thrust along the body axis"),
+        "thrust": (f.thrust_n, "N", "motor thrust along the body axis"),
         **{f"aero_force_{a}": (getattr(f.aero_force_b, a), "N", f"aerodynamic force, body {a} (FRD)") for a in "xyz"},
         **{f"chute_force_{n}": (getattr(f.chute_force_n, a), "N", f"parachutes' force, {n}")
            for a, n in zip("xyz", ("north", "east", "down"))},

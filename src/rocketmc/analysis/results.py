@@ -30,7 +30,7 @@ _PERCENTILES = {"p5": 5.0, "p50": 50.0, "p95": 95.0}
 REQUIRED_OUTPUTS = ("status", "impact_north_m", "impact_east_m")
 """Datasets every result file has (docs/conventions.md) and the report reads."""
 DIVERGED = "navigation_diverged"
-"""The per-flight flag of a navigation estimate that diverged (``sim.flight.NAVIGATION_METRICS``; flights on the
+"""The per-flight flag of a navigation estimate that diverged (``sim.outputs.NAVIGATION_METRICS``; flights on the
 navigation filters only)."""
 
 

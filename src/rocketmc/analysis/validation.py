@@ -19,7 +19,9 @@ from ..campaign import Campaign, nominal_params
 from ..campaign.runner import sim_settings
 from ..env import G0, isa
 from ..math import Vec3
-from ..sim.flight import derivatives, flight_summary, fly
+from ..sim.flight import fly
+from ..sim.loads import derivatives
+from ..sim.outputs import flight_summary
 from .flight_log import FlightReduction
 
 

@@ -12,8 +12,10 @@ import numpy as np
 from ..aero.buildup import MAX_SUBSONIC_MACH
 from ..aero.model import LinearAero
 from ..aero.stability import static_margin_calibers
-from ..sim.flight import OUTSIDE_TABLES_QBAR_FRACTION, mass_properties
+from ..gnc.navigation import NavigationMode
+from ..sim.loads import mass_properties
 from ..sim.params import FlightParams
+from ..sim.state import OUTSIDE_TABLES_QBAR_FRACTION
 from .record import Campaign
 from .model import nominal_params
 
@@ -64,7 +66,7 @@ def calibration_warnings(campaign: Campaign) -> list[str]:
     the magnetometer above ``UNCALIBRATED_FIELD_OFFSET_UT``, the gyroscope above ``UNCALIBRATED_GYRO_BIAS_DEG_S``
     (none without [gnc] navigation = "filters", or for a truth-only sensor)."""
     cfg = campaign.config
-    if cfg.gnc is None or cfg.gnc.navigation != "filters" or cfg.avionics is None:
+    if cfg.gnc is None or NavigationMode(cfg.gnc.navigation) is not NavigationMode.FILTERS or cfg.avionics is None:
         return []
     mag, gyro = cfg.avionics.magnetometer, cfg.avionics.gyroscope
     spreads = {
@@ -88,7 +90,7 @@ def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: 
     flown) above the tables' Mach axis (values clamped at its edge) or, for built-up tables, above the
     subsonic theory's ``MAX_SUBSONIC_MACH``; ``max_altitude_m`` [m MSL] above the tables' altitude axis;
     ``outside_tables`` flights that flew outside any axis (α, β, Mach, altitude) at more than
-    ``sim.flight.OUTSIDE_TABLES_QBAR_FRACTION`` of their maximum dynamic pressure (status 3's criterion, counted
+    ``sim.state.OUTSIDE_TABLES_QBAR_FRACTION`` of their maximum dynamic pressure (status 3's criterion, counted
     whatever status a flight ended with). NaN maxima (no flight ok) are skipped."""
     aero = campaign.aero if campaign.aero is not None else nominal_params(campaign).rocket.aero
     tables = [aero.table] if isinstance(aero, LinearAero) else [t for t in (aero.body, aero.canard_table) if t]

@@ -27,7 +27,7 @@ from ..dynamics.rigid_body import MassProperties
 from ..env.atmosphere import G0, AtmosphereProfile, air
 from ..gnc.design import FlownLoopUnstable, PlantPoint, Schedule, gain_schedule
 from ..math.vectors import Vec3
-from ..sim.flight import mass_properties
+from ..sim.loads import mass_properties
 from ..sim.params import FlightParams, Launch
 from .errors import ConfigError
 from .schema import CampaignConfig

@@ -25,7 +25,7 @@ from ..env.weather import geometric_altitude
 from ..gnc.control import GAIN_NAMES, GncParams
 from ..gnc.attitude_filter import AttitudeTuning
 from ..gnc.guidance import GuidanceParams
-from ..gnc.navigation import FilterParams
+from ..gnc.navigation import FilterParams, NavigationMode
 from ..gnc.position_filter import PositionTuning
 from ..math import Quat, Vec3
 from ..math.table import Table
@@ -35,7 +35,7 @@ from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
 from ..sim.faults import Faults, GnssOutage, SensorStep, SlowCanard, StuckCanard
 from ..env.weather import Weather
-from ..sim.flight import rail_start_n
+from ..sim.events import rail_start_n
 from ..sim.params import Environment, FlightParams, Launch, Rocket, SimSettings
 from .errors import ConfigError
 from .gains import GuidanceReference
@@ -241,9 +241,10 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
         table = Table.from_numpy((schedule.speeds, schedule.altitudes), gains, ("speed", "altitude"), GAIN_NAMES)
     else:
         table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
-    filters = filter_params(campaign) if gnc.navigation == "filters" else None
-    rail = (None, None) if gnc.navigation == "truth" else nominal_rail(campaign)
-    return GncParams(servo, guidance, table, gnc.control.anti_windup, gnc.navigation, filters, *rail)
+    navigation = NavigationMode(gnc.navigation)
+    filters = filter_params(campaign) if navigation is NavigationMode.FILTERS else None
+    rail = (None, None) if navigation is NavigationMode.TRUTH else nominal_rail(campaign)
+    return GncParams(servo, guidance, table, gnc.control.anti_windup, navigation, filters, *rail)
 
 
 def guidance_params(g: GuidanceConfig, reference: GuidanceReference) -> GuidanceParams:
@@ -252,9 +253,9 @@ def guidance_params(g: GuidanceConfig, reference: GuidanceReference) -> Guidance
     return GuidanceParams(
         apogee_m=jnp.asarray(reference.apogee_m), t0_s=jnp.asarray(g.t0_s),
         flight_path_angle_rad=rad(reference.flight_path_angle_deg), heading_rad=rad(reference.heading_deg),
-        gain=jnp.asarray(g.gain), rate_limit=rad(g.rate_limit_deg_s), min_speed=jnp.asarray(g.min_speed_mps),
+        gain=jnp.asarray(g.gain), rate_limit_rad_s=rad(g.rate_limit_deg_s), min_speed_mps=jnp.asarray(g.min_speed_mps),
         roll_gain=jnp.asarray(g.roll_gain), roll_heading_rad=rad(reference.roll_heading_deg),
-        roll_rate_limit=rad(g.roll_rate_limit_deg_s), integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
+        roll_rate_limit_rad_s=rad(g.roll_rate_limit_deg_s), integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
         window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
     )  # fmt: skip
 

@@ -24,7 +24,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..pytree import tree_where
-from ..sim.flight import fly_block, flight_done, flight_summary, initial_state, simulate_one
+from ..sim.flight import fly_block, flight_done, initial_state, simulate_one
+from ..sim.outputs import flight_summary
 from ..sim.params import FlightParams
 from ..sim.params import SimSettings
 from .record import Campaign

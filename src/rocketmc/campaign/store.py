@@ -29,7 +29,8 @@ import numpy as np
 from .. import __version__
 from ..errors import RocketmcError
 from ..files import replacing, replacing_hdf5
-from ..sim.flight import Status, metric
+from ..sim.outputs import metric
+from ..sim.state import Status
 from .record import Campaign
 from .fingerprint import differences, fingerprint, setup
 from .runner import ChunkResult, chunking

@@ -13,7 +13,9 @@ docs/sharp-bits.md).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+from typing import NamedTuple
 
 import jax.numpy as jnp
 
@@ -23,8 +25,12 @@ from ..dynamics.servo import ServoParams, ServoState, hold_command
 from ..math import Quat, Vec3
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
+from ..sensors.avionics import Avionics, AvionicsState, gyroscope_bias_b
 from .design import N_INPUT, N_PLANT, N_STATE
-from .navigation import DeadReckoning, FilterParams, FilterState, initial_dead_reckoning, initial_filters
+from .navigation import (
+    DeadReckoning, FilterParams, FilterState, NavigationMode, bus_measurements, dead_reckoning, filter_step,
+    initial_dead_reckoning, initial_filters, liftoff_sensed, navigation_summary, track_errors,
+)  # fmt: skip
 from .guidance import GuidanceParams, Navigation, guidance_active, integrate_errors, rate_command
 
 GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
@@ -37,16 +43,16 @@ class GncParams:
     """servo: the canard servos; guidance: the reference and the rate command; gains: ``Table`` of K over
     ``speed`` (axial body speed u [m/s]) and, when the design grid has several, ``altitude`` (above mean sea
     level [m]), outputs ``GAIN_NAMES`` (clamped at the grid's edges); anti_windup: conditional integration
-    (``gnc_step``; static); navigation: "truth", "sensors" or "filters" (``gnc.navigation``; static); filters: the
-    navigation filters' parameters (None unless "filters"); rail_q_nb, rail_r_n: what the avionics know of the
+    (``gnc_step``; static); navigation: what the controller reads (``NavigationMode``; static); filters: the
+    navigation filters' parameters (None unless FILTERS); rail_q_nb, rail_r_n: what the avionics know of the
     launch, the campaign's nominal rail: its attitude (body → NED) and the CG's position at rest on it [m, NED],
-    where navigation from the sensors starts (None with "truth")."""
+    where navigation from the sensors starts (None with TRUTH)."""
 
     servo: ServoParams
     guidance: GuidanceParams
     gains: Table
     anti_windup: bool = static_field()
-    navigation: str = static_field()
+    navigation: NavigationMode = static_field()
     filters: FilterParams | None = None
     rail_q_nb: Quat | None = None
     rail_r_n: Vec3 | None = None
@@ -59,9 +65,9 @@ class GncState:
     commands (yaw, pitch, roll) [rad]; saturated: they clipped a fin at its limit (bool). Flight totals for the outputs: active_time [s] with the controller
     active; tracking_sq, ∫χ² dt [rad²·s], and deflection_sq, ∫ mean over the fins of δ² dt [rad²·s], over that
     time; saturated_time [s] active with a fin saturated; max_deflection, the largest |δ| of any fin at a
-    period start [rad]. navigation: the navigation's state (``gnc.navigation``: ``DeadReckoning`` with "sensors",
-    ``FilterState`` with "filters", None with "truth"); recovery: the parachutes' triggers from that navigation
-    (``Recovery``; None with "truth")."""
+    period start [rad]. navigation: the navigation's state (``gnc.navigation``: ``DeadReckoning`` with SENSORS,
+    ``FilterState`` with FILTERS, None with TRUTH); recovery: the parachutes' triggers from that navigation
+    (``Recovery``; None with TRUTH)."""
 
     servo: ServoState
     integrators: Vec3
@@ -100,7 +106,7 @@ def sensed_triggers(state: Recovery, nav: Navigation, true_height_m, moving, can
     once the estimated vertical velocity has pointed down for ``APOGEE_DESCENDING_TICKS`` ticks after the sensed
     liftoff (``moving``), when the parachutes triggered at apogee (``trigger_altitudes_m`` inf) trigger, at t; the
     navigation's height error against ``true_height_m`` [m] kept while no canopy is out (bool ``canopy``). The
-    altitude triggers fire inside the integration (``sim.flight.update_events``) where the true height plus that
+    altitude triggers fire inside the integration (``sim.events.update_events``) where the true height plus that
     error crosses their altitude. Returns the new state and the trigger times [s] (``trigger_times``, inf before)."""
     descending = moving & (nav.v_n.z > 0.0)
     ticks = jnp.where(descending, state.descending_ticks + 1, 0)
@@ -114,14 +120,16 @@ def sensed_triggers(state: Recovery, nav: Navigation, true_height_m, moving, can
 
 def initial_gnc(params: GncParams, like) -> GncState:
     """At rest on the rail: servos at their zero, integrators empty, no liftoff yet, navigation from the sensors
-    (``params.navigation`` "sensors" or "filters") at the nominal rail (``params.rail_q_nb``, ``rail_r_n``); ``like``
+    (``params.navigation`` SENSORS or FILTERS) at the nominal rail (``params.rail_q_nb``, ``rail_r_n``); ``like``
     a scalar of the flight's dtype."""
     zero = jnp.zeros_like(like)
     fins = jnp.zeros_like(params.servo.offset_rad)
     q_nb0, r_n0 = params.rail_q_nb, params.rail_r_n
-    navigation = {"truth": lambda: None, "sensors": lambda: initial_dead_reckoning(q_nb0),
-                  "filters": lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
-    recovery = None if params.navigation == "truth" else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf, zero)
+    navigation = {NavigationMode.TRUTH: lambda: None,
+                  NavigationMode.SENSORS: lambda: initial_dead_reckoning(q_nb0),
+                  NavigationMode.FILTERS: lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
+    recovery = (None if params.navigation is NavigationMode.TRUTH
+                else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf, zero))  # fmt: skip
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),
@@ -206,12 +214,74 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
 
 
 def truth(body: RigidBodyState) -> tuple[Navigation, jnp.ndarray]:
-    """Perfect navigation (``navigation = "truth"``): the vehicle's true state, and whether it moves."""
+    """Perfect navigation (``NavigationMode.TRUTH``): the vehicle's true state, and whether it moves."""
     return Navigation(body.r_n, body.v_n, body.q_nb, body.omega_b), body.v_n.dot(body.v_n) > 0.0
 
 
+class Navigated(NamedTuple):
+    """What the navigation gives the controller at a GNC tick (``navigate``): solution, the navigation solution;
+    moving, whether it sees the rocket off the pad (bool); state, the GNC's state with its navigation and recovery
+    advanced; trigger_times, the parachutes' trigger times [s] (inf before) from the navigation (``sensed_triggers``),
+    or None: the true apogee and height trigger them (``sim.events.update_events``); feedback_rad, the servo
+    positions δ1..δn [rad] the LQI reads (the canard-feedback sensor's), or None: the servos' true deflections."""
+
+    solution: Navigation
+    moving: jnp.ndarray
+    state: GncState
+    trigger_times: tuple | None
+    feedback_rad: jnp.ndarray | None
+
+
+def navigate(params: GncParams, av: Avionics | None, state: GncState, body: RigidBodyState,
+             sensed: AvionicsState | None, t, canopy, trigger_altitudes_m, trigger_times) -> Navigated:  # fmt: skip
+    """The navigation of ``params.navigation`` at the GNC tick t [s]: TRUTH, the true ``body``;
+    SENSORS, the raw sensors on the bus of ``sensed`` (the avionics' state; ``av``: the sensors as the
+    flight software knows them), and FILTERS, the filters on it, both with liftoff from the accelerometer and the
+    parachutes' triggers (``sensed_triggers``, with ``trigger_altitudes_m`` [m above the pad] and the trigger times
+    so far ``trigger_times`` [s]). canopy: a parachute has been triggered (bool)."""
+    if params.navigation is NavigationMode.TRUTH:
+        return Navigated(*truth(body), state, None, None)
+    bus = sensed.bus
+    # liftoff latched: after burnout the accelerometer reads less than the 2 g that sensed it
+    moving = liftoff_sensed(av, bus) | jnp.isfinite(state.liftoff_time)
+    if params.navigation is NavigationMode.SENSORS:
+        nav, navigation = dead_reckoning(av, state.navigation, bus, t)
+    else:
+        nav, navigation = filter_step(params.filters, state.navigation, bus_measurements(av, bus), t, moving, canopy)
+    recovery, triggers = sensed_triggers(state.recovery, nav, -body.r_n.z, moving, canopy, t, trigger_altitudes_m,
+                                         trigger_times)  # fmt: skip
+    state = dataclasses.replace(state, navigation=navigation, recovery=recovery)
+    feedback = jnp.where(bus.canard_feedback.valid, bus.canard_feedback.value, 0.0)  # the servos' sensed positions
+    return Navigated(nav, moving, state, triggers, feedback)
+
+
+def track_navigation(params: GncParams, state: GncState, t, dt, canopy, body: RigidBodyState, av: Avionics | None,
+                     sensed: AvionicsState | None, ascent, burnt, past_apogee) -> GncState:  # fmt: skip
+    """``state`` (after ``gnc_step`` at the period start t [s]) with, on the FILTERS, their errors against the truth
+    accumulated (``track_errors``): the true ``body`` and gyroscope bias (of ``av``, the sensors as they sample at t,
+    and their state ``sensed``); over the GNC period dt [s] while the controller is active (the guidance window
+    from the sensed liftoff, no parachute: bool ``canopy``) and while ``ascent`` (the true first motion to apogee,
+    bool), and at the first tick ``burnt`` and ``past_apogee`` (bool). Other navigation: ``state`` itself."""
+    if params.navigation is not NavigationMode.FILTERS:
+        return state
+    window = guidance_active(params.guidance, t - state.liftoff_time) & ~canopy
+    navigation = track_errors(state.navigation, body.q_nb, body.r_n, body.v_n, gyroscope_bias_b(av, sensed),
+                              jnp.where(window, dt, 0.0), jnp.where(ascent, dt, 0.0), burnt, past_apogee)  # fmt: skip
+    return dataclasses.replace(state, navigation=navigation)
+
+
+def gnc_summary(params: GncParams, state: GncState, burnout_speed_mps) -> tuple[dict, jnp.ndarray | None]:
+    """The closed loop's per-flight outputs: the controller's (``control_summary``) and, on the FILTERS, theirs
+    (``navigation.navigation_summary``, with the burnout speed [m/s]); and whether the filters failed (bool; None
+    on other navigation)."""
+    summary = control_summary(state)
+    if params.navigation is not NavigationMode.FILTERS:
+        return summary, None
+    return {**summary, **navigation_summary(state.navigation, burnout_speed_mps)}, state.navigation.failed
+
+
 def control_summary(state: GncState) -> dict:
-    """The controller's per-flight outputs (``sim.flight.CONTROL_METRICS``); NaN where it never acted."""
+    """The controller's per-flight outputs (``sim.outputs.CONTROL_METRICS``); NaN where it never acted."""
     acted = state.active_time > 0.0
     per_active = 1.0 / jnp.where(acted, state.active_time, 1.0)
     return {

@@ -37,11 +37,11 @@ class GuidanceParams:
 
     Reference parabola: apogee_m, the height H [m] the reference climbs after t0_s [s]; flight_path_angle_rad,
     γ0, the reference's flight-path angle at t0 (above the horizon) [rad]; heading_rad, ψ, its azimuth
-    clockwise from north [rad] (the launch azimuth). gain: k [1/s]; rate_limit: the 2-norm limit of the
-    pitch and yaw rate command [rad/s]; min_speed: below this inertial speed [m/s] the pitch and yaw command
+    clockwise from north [rad] (the launch azimuth). gain: k [1/s]; rate_limit_rad_s: the 2-norm limit of the
+    pitch and yaw rate command [rad/s]; min_speed_mps: below this inertial speed [m/s] the pitch and yaw command
     is zero. Roll: roll_gain [1/s], roll_heading_rad the azimuth [rad] the body z axis is steered toward,
-    roll_rate_limit [rad/s]. integrator_gain: k_int of e_p, e_q, e_r [-]. window_start_s, window_end_s: guidance
-    acts for window_start_s ≤ t < window_end_s [s since liftoff].
+    roll_rate_limit_rad_s [rad/s]. integrator_gain: k_int of e_p, e_q, e_r [-]. window_start_s, window_end_s:
+    guidance acts for window_start_s ≤ t < window_end_s [s since liftoff].
     """
 
     apogee_m: jnp.ndarray
@@ -49,11 +49,11 @@ class GuidanceParams:
     flight_path_angle_rad: jnp.ndarray
     heading_rad: jnp.ndarray
     gain: jnp.ndarray
-    rate_limit: jnp.ndarray
-    min_speed: jnp.ndarray
+    rate_limit_rad_s: jnp.ndarray
+    min_speed_mps: jnp.ndarray
     roll_gain: jnp.ndarray
     roll_heading_rad: jnp.ndarray
-    roll_rate_limit: jnp.ndarray
+    roll_rate_limit_rad_s: jnp.ndarray
     integrator_gain: Vec3
     window_start_s: jnp.ndarray
     window_end_s: jnp.ndarray
@@ -93,10 +93,10 @@ def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.
     docs/gnc.md §4, V = nav.v_n: χ = ∠(V, d_ref) ∈ [0, π], computed as atan2(‖V×d‖, V·d) (the thesis's
     acos(V·d/‖V‖) loses digits near 0); n = V×d/‖V×d‖ (NED, 0 when V ∥ d), the axis about which a rotation by
     +χ turns V onto d (right-handed); ω_b = k χ A(q) n. Pitch and yaw: (q, r) = ω_b's y, z components, scaled
-    together to a 2-norm of at most rate_limit, zero when ‖V‖ ≤ min_speed (ω_b's x component is dropped).
-    Roll: t_b = A(q) (cos ψ_roll, sin ψ_roll, 0), the roll error φ_e = atan2(−t_b,y, t_b,z) ∈ (−π, π] is the
+    together to a 2-norm of at most ``rate_limit_rad_s``, zero when ‖V‖ ≤ ``min_speed_mps`` (ω_b's x component is
+    dropped). Roll: t_b = A(q) (cos ψ_roll, sin ψ_roll, 0), the roll error φ_e = atan2(−t_b,y, t_b,z) ∈ (−π, π] is the
     rotation about +x_b that takes the body z axis onto t_b's lateral (y, z) part (positive p turns z_b toward
-    −y_b); p = clip(roll_gain φ_e, ±roll_rate_limit). All three are zero outside the window; χ is returned
+    −y_b); p = clip(roll_gain φ_e, ±roll_rate_limit_rad_s). All three are zero outside the window; χ is returned
     at every t (the reference is defined at every t).
     """
     v = nav.v_n
@@ -107,12 +107,12 @@ def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.
     axis_n = cross * (1.0 / jnp.where(sin_part > 0.0, sin_part, 1.0))
     axis_b = nav.q_nb.rotate_inverse(axis_n)
     fly = guidance_active(params, t)
-    steer = fly & (v.norm() > params.min_speed)
-    q_cmd, r_cmd = _clip_norm2(params.gain * chi * axis_b.y, params.gain * chi * axis_b.z, params.rate_limit)
+    steer = fly & (v.norm() > params.min_speed_mps)
+    q_cmd, r_cmd = _clip_norm2(params.gain * chi * axis_b.y, params.gain * chi * axis_b.z, params.rate_limit_rad_s)
     ch, sh = jnp.cos(params.roll_heading_rad), jnp.sin(params.roll_heading_rad)
     target_b = nav.q_nb.rotate_inverse(Vec3(ch, sh, jnp.zeros_like(ch)))
     roll_error = jnp.arctan2(-target_b.y, target_b.z)
-    p_cmd = jnp.clip(params.roll_gain * roll_error, -params.roll_rate_limit, params.roll_rate_limit)
+    p_cmd = jnp.clip(params.roll_gain * roll_error, -params.roll_rate_limit_rad_s, params.roll_rate_limit_rad_s)
     command = Vec3(jnp.where(fly, p_cmd, 0.0), jnp.where(steer, q_cmd, 0.0), jnp.where(steer, r_cmd, 0.0))
     return command, chi
 

@@ -1,5 +1,6 @@
-"""Navigation from the avionics bus: ``navigation = "sensors"``, raw sensors, and ``"filters"``, the MEKF
-(``attitude_filter``) and the position/velocity Kalman filter (``position_filter``).
+"""Navigation from the avionics bus (``NavigationMode``): ``SENSORS`` (``navigation = "sensors"``), raw sensors,
+and ``FILTERS`` (``"filters"``), the MEKF (``attitude_filter``) and the position/velocity Kalman filter
+(``position_filter``).
 
 Raw sensors: body rates from the gyroscope, the launch attitude propagated by the gyroscope's rates (no
 correction: its bias and noise integrate), position and velocity from the GNSS, held between fixes (zero
@@ -15,6 +16,7 @@ solution (the thesis fed the a-priori one forward, a tick late). Frames: NED fro
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 
 import jax.numpy as jnp
@@ -33,6 +35,17 @@ from .position_filter import (
     PositionEstimate, PositionTuning, altitude_nis, altitude_update, gnss_nis, gnss_update, initial_position, position_nees,
     propagate_position,
 )  # fmt: skip
+
+
+class NavigationMode(enum.Enum):
+    """What the controller reads (``gnc.control.navigate``); the value is the campaign's [gnc] ``navigation``:
+    TRUTH, the true state; SENSORS, the raw sensors (``dead_reckoning``); FILTERS, the MEKF and the
+    position/velocity Kalman filter on the bus (``filter_step``)."""
+
+    TRUTH = "truth"
+    SENSORS = "sensors"
+    FILTERS = "filters"
+
 
 LIFTOFF_SPECIFIC_FORCE_MPS2 = 2.0 * G0
 """Liftoff is sensed once the accelerometer reads more than this along the rocket's axis: at rest on the rail
@@ -347,7 +360,7 @@ DIVERGED_MEANING = (
     f"then, or a filter's NEES averaged over that time above {DIVERGED_NEES:g}); 0: it did not. Kept in the ellipse: "
     "the flight flew so"
 )
-"""``navigation_diverged``'s meaning (``sim.flight.NAVIGATION_METRICS``)."""
+"""``navigation_diverged``'s meaning (``sim.outputs.NAVIGATION_METRICS``)."""
 
 
 def navigation_diverged(summary: dict, burnout_speed_mps) -> jnp.ndarray:
@@ -360,7 +373,7 @@ def navigation_diverged(summary: dict, burnout_speed_mps) -> jnp.ndarray:
 
 
 def navigation_summary(state: FilterState, burnout_speed_mps) -> dict:
-    """The filters' per-flight outputs (``sim.flight.NAVIGATION_METRICS``); NaN where their span never came, but
+    """The filters' per-flight outputs (``sim.outputs.NAVIGATION_METRICS``); NaN where their span never came, but
     ``navigation_diverged`` (0 or 1; ``burnout_speed_mps``: the true speed at burnout [m/s], NaN before)."""
     e = state.errors
 
