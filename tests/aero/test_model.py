@@ -25,6 +25,8 @@ from rocketmc.aero.sources import build_up_tables, with_axial_curve
 from rocketmc.math import Vec3
 from rocketmc.math.table import Table
 
+from ..conftest import CAMPAIGNS
+
 REFERENCE_POINT_M = 1.33
 THESIS = dict(
     reference_area_m2=0.01767, reference_length_m=0.15, moment_ref_x_m=0.0,
@@ -234,7 +236,7 @@ def test_build_up_rocket_gets_the_power_on_base_drag_change():
     from rocketmc.aero import drag
     from rocketmc.campaign import load_campaign
 
-    campaign = load_campaign("campaigns/custom_rocket.toml")
+    campaign = load_campaign(CAMPAIGNS / "custom_rocket.toml")
     increment = campaign.aero.power_on_ca
     mach = np.asarray(increment.axes[0])
     expected = -drag.base_drag_coefficient(mach) * (0.075 / 0.127) ** 2
