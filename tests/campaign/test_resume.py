@@ -21,6 +21,8 @@ from rocketmc.cli import main
 from ..conftest import CAMPAIGNS
 from .error_sources import assert_every_fault_recorded, write_every_error_source
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 ARGS = ["-n", "160", "--chunk-size", "16", "--seed", "5"]  # 10 chunks of ~0.3 s each after compilation
 
 

@@ -169,7 +169,7 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
     saturates the fins could never unwind."""
     liftoff_time = jnp.where(jnp.isinf(state.liftoff_time) & moving, t, state.liftoff_time)
     since_liftoff = t - liftoff_time  # −inf before liftoff: outside any window
-    active = guidance_active(params.guidance, since_liftoff) & ~canopy
+    active = guidance_active(params.guidance, since_liftoff) & ~jnp.asarray(canopy)  # canopy: False without parachutes
     rates_cmd, chi = rate_command(params.guidance, nav, since_liftoff)
     v_b = nav.q_nb.rotate_inverse(nav.v_n)
     k = gains_at(params.gains, v_b.x, altitude_msl)

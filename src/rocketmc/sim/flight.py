@@ -500,7 +500,7 @@ def _tracked(p: FlightParams, settings: SimSettings, state: FlightState, gnc: Gn
     (``track_errors``): the window is the controller's active time (the guidance window from the sensed liftoff, no
     parachute), the ascent from the true first motion to apogee."""
     body, events, dt = state.body, state.events, settings.control_dt_s
-    window = guidance_active(p.gnc.guidance, state.t - gnc.liftoff_time) & ~canopy
+    window = guidance_active(p.gnc.guidance, state.t - gnc.liftoff_time) & ~jnp.asarray(canopy)
     ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
     return track_errors(gnc.navigation, body.q_nb, body.r_n, body.v_n,
                         gyroscope_bias_b(_avionics_at(p, state.t), state.avionics),
