@@ -5,7 +5,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 N ?= 1000
 
-.PHONY: install demo test bench clean
+.PHONY: install demo test test-fast bench clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,6 +22,9 @@ demo: install
 
 test: install  # timing tests (-m performance) alone, after the parallel ones
 	$(PY) -m pytest -n 2 -q -m "not performance" && $(PY) -m pytest -q -m performance
+
+test-fast: install  # the suite without the slow tests (-m slow) and the timing ones
+	$(PY) -m pytest -n 2 -q -m "not slow and not performance"
 
 bench: install
 	$(VENV)/bin/rocketmc bench

@@ -15,6 +15,11 @@ import pytest
 
 import rocketmc  # noqa: F401  (enables jax_enable_x64)
 
+# Every test runs under strict dtype promotion and with implicit rank promotion refused, so that
+# a mixed-dtype or silently broadcast operation in the library fails the tests instead of passing.
+jax.config.update("jax_numpy_dtype_promotion", "strict")
+jax.config.update("jax_numpy_rank_promotion", "raise")
+
 REPO = Path(__file__).resolve().parents[1]
 CAMPAIGNS = REPO / "campaigns"
 MOTORS = REPO / "src" / "rocketmc" / "data" / "motors"

@@ -137,6 +137,7 @@ def test_gnc_design(tmp_path, capsys):
     assert not (tmp_path / "none.png").exists()
 
 
+@pytest.mark.slow
 def test_until_converged_stops_by_itself(tmp_path, capsys):
     """lynx_ballistic with a 25 % target: the 95 % ellipse area's bootstrap interval is that narrow after a
     few hundred flights (its width goes as ~3.9/sqrt(N)), far below the 2000 allowed; the file keeps the

@@ -7,10 +7,13 @@ from pathlib import Path
 
 import nbformat
 import pandas as pd
+import pytest
 from nbclient import NotebookClient
 
 from rocketmc.analysis import load_run
 from rocketmc.sim.outputs import CONTROL_METRICS
+
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
 
 REPO = Path(__file__).resolve().parents[1]
 N = 64

@@ -139,7 +139,8 @@ def test_datcom_static_slopes_match_its_derivatives(lynx, raw):
     i = (index(axes[0], 0.0), index(axes[1], 0.3), index(axes[2], 0.0), 0)
     assert round(float(c["CNA"][i]), 2) == 10.10 and round(float(c["CMA"][i]), 1) == -23.1
     assert slope(lynx, "CN", "alpha", 0.5) == pytest.approx(c["CNA"][i], rel=0.02)
-    assert slope(lynx, "Cm", "alpha", 0.5) == pytest.approx(c["CMA"][i], rel=0.02)
+    # Cm has no crossflow steepening to speak of: the rounding's 0.26 % bounds it (measured 0.08 %), 0.5 % guards it
+    assert slope(lynx, "Cm", "alpha", 0.5) == pytest.approx(c["CMA"][i], rel=5e-3)
     # β slopes over ±0.1° (CY, Cn bend already at 2.5°), 3 %: the rounding alone is
     # ±0.001/0.0035 rad = ±0.29 /rad (2.8 % of CYB, 1.2 % of CLNB), and Cn(0.1°) = 0.040 sits 2 %
     # under CLNB·β.
@@ -232,7 +233,8 @@ def test_re_referenced_pitch_arms(lynx):
     out, new = lynx.body.output, moved.body.output
     np.testing.assert_allclose(new("Cm"), out("Cm") + out("CN") * arm, rtol=1e-14, atol=1e-14)  # float rounding
     np.testing.assert_allclose(new("Cmq"), out("Cmq") + out("CNq") * arm, rtol=1e-14, atol=1e-12)
-    assert slope(moved, "Cm", "alpha", 0.5) == pytest.approx(-33.9, rel=0.02)  # the 2 % of the DATCOM slopes
+    # measured -33.97 (0.2 % off the 3-digit -33.9: the slopes' rounding, 0.26 %, above): 0.5 % guards it
+    assert slope(moved, "Cm", "alpha", 0.5) == pytest.approx(-33.9, rel=5e-3)
 
 
 # --- HDF5 ----------------------------------------------------------------------------------------

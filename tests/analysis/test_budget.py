@@ -17,6 +17,8 @@ from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, ru
 from rocketmc.campaign.runner import run_chunks
 from rocketmc.cli import main
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 CAMPAIGN = CAMPAIGNS / "lynx_ballistic_gnc_1s.toml"
 N = 16

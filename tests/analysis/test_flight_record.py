@@ -15,6 +15,8 @@ from rocketmc.campaign import load_campaign, run_chunks, with_overrides
 from rocketmc.campaign.model import nominal_params
 from rocketmc.env import G0
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 N, REALIZATION = 16, 11
 

@@ -35,6 +35,8 @@ from rocketmc.gnc.navigation import bus_measurements, filter_step, initial_filte
 from rocketmc.math import Quat, Vec3
 from rocketmc.sim.flight import fly
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 ROOT = Path(__file__).parents[2]
 CAMPAIGN = ROOT / "campaigns" / "lynx_nominal_gnc_1s.toml"
 FLIGHT_S = 25.0  # past apogee (~19 s): boost, coast and the drogue's first seconds

@@ -19,6 +19,8 @@ import pytest
 from rocketmc.campaign import load_campaign, run_chunks, with_overrides
 from rocketmc.cli import main
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 
 

@@ -33,6 +33,8 @@ from ..conftest import CAMPAIGNS
 from .error_sources import assert_every_fault_recorded, write_every_error_source
 from .test_resume import assert_same, contents
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 CAMPAIGN = str(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")  # the full GNC: sensors, navigation filters, controller
 # (the bits are compared on it with every error source and fault on, ``faulted``; the other tests fly nothing)
 N, CHUNK, SEED = 16, 2, 7  # 8 chunks of ~0.5 s on one worker core once compiled

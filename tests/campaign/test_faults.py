@@ -21,6 +21,8 @@ from .error_sources import FAULT_KINDS as KINDS
 from .error_sources import FAULTS as EVERY_FAULT
 from .test_runner import collect
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 GNC = (CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text()
 FAULTS = EVERY_FAULT.replace("probability = 0.5", "probability = 0.3")
 DRAWS = 400

@@ -15,6 +15,8 @@ from rocketmc.campaign.model import nominal_params
 
 from ..conftest import CAMPAIGNS
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 TWINS = ["lynx_ballistic_gnc_1s", "lynx_ballistic_gnc_3p5s", "lynx_nominal_gnc_1s"]
 REALISTIC_ONLY = ("avionics.", "environment.magnetic_field.", "launch.elevation_deg", "launch.azimuth_deg")
 """The dispersions a realistic campaign adds to its twin's: per-flight sensor errors, the anomaly, the rail."""

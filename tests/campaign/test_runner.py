@@ -7,6 +7,8 @@ import pytest
 
 from rocketmc.campaign import parse_campaign, run_chunks, with_overrides
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 
 

@@ -30,6 +30,8 @@ from rocketmc.cli import main
 from ..conftest import CAMPAIGNS, MOTORS
 from .test_resume import assert_same, contents
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 ARGS = ["-n", "24", "--chunk-size", "8", "--quiet"]  # the campaign's interpolated model: loaded in ~0.1 s
 # (the simplified one is linearised anew at each load, ~5 s)
 N_CHUNKS = 3

@@ -21,6 +21,8 @@ from rocketmc.campaign import load_campaign, with_overrides
 from rocketmc.cli import main
 from rocketmc.env import G0
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 CAMPAIGNS = Path(__file__).parents[2] / "campaigns"
 N, SEED, KEPT, INTERVAL_S = 6, 3, (1, 4), 0.1
 ARGS = ["-n", str(N), "--seed", str(SEED), "--quiet"]

@@ -194,6 +194,7 @@ def test_the_day_s_wind_turned_and_scaled(tmp_path):
     np.testing.assert_allclose([got.x, got.y], [speed * math.cos(to), speed * math.sin(to)], rtol=1e-6)
 
 
+@pytest.mark.slow
 def test_a_sounding_campaign_flies_end_to_end(tmp_path, capsys):
     out = tmp_path / "s.h5"
     assert main(["run", str(ROOT / "campaigns" / "lynx_euroc_sounding.toml"), "-n", "16", "--out", str(out),

@@ -373,7 +373,7 @@ def monte_carlo_run(key):
         return (est, q_true, bias), (nees, bias_error2, bias_var)
 
     noise = jax.random.normal(k_noise, (MC_TICKS, 3, 3))
-    return jax.lax.scan(tick, (est, q_true, bias), (jnp.arange(MC_TICKS), noise))[1]
+    return jax.lax.scan(tick, (est, q_true, bias), (jnp.arange(MC_TICKS, dtype=float), noise))[1]
 
 
 def test_monte_carlo_nees_is_consistent_and_bias_converges():

@@ -32,10 +32,10 @@ def oscillator(t, s: Oscillator):
 
 
 def _integrate(f, y0, t_end, n):
-    h = t_end / n
+    h = t_end / n.astype(float)
 
     def body(i, y):
-        return rk4_step(f, i * h, y, h)[0]
+        return rk4_step(f, i.astype(float) * h, y, h)[0]
 
     return jax.lax.fori_loop(0, n, body, y0)  # n is traced: one compilation for every n
 

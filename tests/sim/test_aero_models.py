@@ -15,7 +15,7 @@ from rocketmc.sim.state import Status
 
 def test_interpolated_and_simplified_apogees_within_2_percent(lynx_campaign):
     """The simplified model is the interpolated one linearised at zero angles; a nominal flight
-    stays at small angles except on the rail and near apogee, so the apogees agree to ~0.5 %; the
+    stays at small angles except on the rail and near apogee, so the apogees agree to ~0.6 %; the
     2 % bound is the project's acceptance (docs/validation.md)."""
     apogees = {}
     for model, kind in (("interpolated", TableAero), ("simplified", LinearAero)):
@@ -25,3 +25,5 @@ def test_interpolated_and_simplified_apogees_within_2_percent(lynx_campaign):
         assert int(status) == Status.OK
         apogees[model] = float(summary["apogee_agl_m"])
     assert apogees["simplified"] == pytest.approx(apogees["interpolated"], rel=0.02)
+    # Measured 0.61 % (9.6 m): 1 % guards today's agreement (a deterministic model difference, not round-off).
+    assert apogees["simplified"] == pytest.approx(apogees["interpolated"], rel=0.01)

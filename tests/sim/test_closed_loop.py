@@ -27,6 +27,8 @@ from rocketmc.sim.outputs import flight_summary
 
 from ..conftest import CAMPAIGNS
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 N_PERIODS = 650  # 13 s at 0.02 s: ignition at 0.5 s, the window ends 10 s after liftoff (~0.6 s)
 
 

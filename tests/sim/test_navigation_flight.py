@@ -33,6 +33,8 @@ from rocketmc.sim.state import Status
 
 from ..conftest import CAMPAIGNS
 
+pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
+
 N_PERIODS = 1000  # 20 s at 0.02 s: past the window (10 s after liftoff), burnout (~4 s) and apogee (~19 s)
 ATTITUDE_DEG, VELOCITY_MPS = 6.0, 2.0
 """Bounds on the thesis filters' errors through the ascent, measured 4.05° (near apogee: the roll about the field

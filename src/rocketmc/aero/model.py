@@ -219,7 +219,7 @@ def linear_coefficients(aero: LinearAero, air: AirData, deflections, burning=Fal
     quadratic = values[k + 5 * n :].reshape(n, n)
     delta = jnp.asarray(deflections)
     # elementwise sums, not ``@``: a vmapped dot of a few numbers is a slow library call on CPU
-    d_cy, d_cn, d_cl, d_cm, d_cn_yaw = jnp.sum(control * delta, axis=1) if n else jnp.zeros(5)
+    d_cy, d_cn, d_cl, d_cm, d_cn_yaw = jnp.sum(control * delta[None, :], axis=1) if n else jnp.zeros(5)
     drag_delta = jnp.sum(quadratic * delta[:, None] * delta[None, :]) if n else 0.0
     ca = aero.drag_scale * (c["CA0"] + power_on_axial(aero, air, burning)) + drag_delta
     coefficients = AeroCoefficients(

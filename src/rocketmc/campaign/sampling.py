@@ -67,7 +67,7 @@ def sample_faults(faults: FaultsConfig | None, key, n_fins: int = 4) -> dict:
         else:
             values["time_s"] = jax.random.uniform(k("time_s"), minval=f.time_s[0], maxval=f.time_s[1])
         if name in ("stuck_canard", "slow_canard"):
-            values["fin"] = (jax.random.randint(k("fin"), (), 1, n_fins + 1) if f.fin is None else f.fin) * 1.0
+            values["fin"] = jax.random.randint(k("fin"), (), 1, n_fins + 1).astype(float) if f.fin is None else f.fin * 1.0
         if name in UNIT_FIELDS:
             magnitude, vector = UNIT_FIELDS[name]
             direction = jax.random.normal(k("direction"), (3,))

@@ -177,7 +177,7 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
     saturates the fins could never unwind."""
     liftoff_time = jnp.where(jnp.isinf(state.liftoff_time) & moving, t, state.liftoff_time)
     since_liftoff = t - liftoff_time  # −inf before liftoff: outside any window
-    active = guidance_active(params.guidance, since_liftoff) & ~canopy
+    active = guidance_active(params.guidance, since_liftoff) & ~jnp.asarray(canopy)  # canopy: False without parachutes
     rates_cmd, chi = rate_command(params.guidance, nav, since_liftoff)
     v_b = nav.q_nb.rotate_inverse(nav.v_n)
     k = gains_at(params.gains, v_b.x, altitude_msl)
@@ -264,7 +264,7 @@ def track_navigation(params: GncParams, state: GncState, t, dt, canopy, body: Ri
     bool), and at the first tick ``burnt`` and ``past_apogee`` (bool). Other navigation: ``state`` itself."""
     if params.navigation is not NavigationMode.FILTERS:
         return state
-    window = guidance_active(params.guidance, t - state.liftoff_time) & ~canopy
+    window = guidance_active(params.guidance, t - state.liftoff_time) & ~jnp.asarray(canopy)  # canopy: False without parachutes
     navigation = track_errors(state.navigation, body.q_nb, body.r_n, body.v_n, gyroscope_bias_b(av, sensed),
                               jnp.where(window, dt, 0.0), jnp.where(ascent, dt, 0.0), burnt, past_apogee)  # fmt: skip
     return dataclasses.replace(state, navigation=navigation)

@@ -267,13 +267,13 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
                           attitude)  # fmt: skip
 
     on_pad = ~moving
-    pad_ticks = state.pad_ticks + on_pad
+    pad_ticks = state.pad_ticks + on_pad.astype(state.pad_ticks.dtype)
     pad_force_b = tree_where(on_pad & m.force_fresh, state.pad_force_b + m.force_b, state.pad_force_b)
     pad_field_b = tree_where(on_pad & m.field_fresh, state.pad_field_b + m.field_b, state.pad_field_b)
     pad_rate_b = tree_where(on_pad & m.omega_valid, state.pad_rate_b + m.omega_b, state.pad_rate_b)
-    pad_rate_count = state.pad_rate_count + (on_pad & m.omega_valid)
+    pad_rate_count = state.pad_rate_count + (on_pad & m.omega_valid).astype(state.pad_rate_count.dtype)
     pad_pressure_sum = state.pad_pressure_sum + jnp.where(on_pad & m.pressure_fresh, m.pressure, 0.0)
-    pad_pressure_count = state.pad_pressure_count + (on_pad & m.pressure_fresh)
+    pad_pressure_count = state.pad_pressure_count + (on_pad & m.pressure_fresh).astype(state.pad_pressure_count.dtype)
     if params.pad_samples:
         aligned = on_pad & (pad_ticks == params.pad_samples)
         if params.heading_from_field:
@@ -298,7 +298,8 @@ def filter_step(params: FilterParams, state: FilterState, m: Measurements, t, mo
         height = pressure_height_m(m.pressure, pad_pressure)
         height_ok = innovation_gate(params.altitude_gate, lambda: altitude_nis(position, height, params.position))
         position = tree_where(use & height_ok, altitude_update(position, height, params.position), position)
-    rejected = state.rejected + jnp.stack([m.field_fresh & ~field_ok, fix & ~gnss_ok, use & ~height_ok], axis=-1)
+    rejects = jnp.stack([m.field_fresh & ~field_ok, fix & ~gnss_ok, use & ~height_ok], axis=-1)
+    rejected = state.rejected + rejects.astype(state.rejected.dtype)
 
     omega_measured_b = tree_where(m.omega_valid, m.omega_b, Vec3(0.0, 0.0, 0.0))
     new = FilterState(t, attitude, position, omega_measured_b, pad_force_b, pad_field_b, pad_rate_b,

@@ -201,7 +201,7 @@ def normals(keys, widths, samples):
     s = samples[:, None]
     shape = (s.shape[0], len(pairs))
     hi = jnp.broadcast_to(s >> np.uint32(24), shape)
-    lo = (s << np.uint32(8)) | np.array([j for _, j in pairs], np.uint32)
+    lo = (s << np.uint32(8)) | np.array([j for _, j in pairs], np.uint32)[None, :]
     # keys (1, pairs), not broadcast to the block: XLA's rolled threefry loop carries (and copies) its key schedule
     # at their shape (the draws 1.5x faster standalone, measured)
     k1, k2 = (jnp.stack([data[i][half] for i, _ in pairs])[None] for half in (0, 1))
