@@ -36,7 +36,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from . import PRECISION
-from .analysis.ellipse import confidence_ellipse
+from .ellipse import confidence_ellipse
 from .campaign import load_campaign, run_chunks
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings
 from .sim.flight import Status

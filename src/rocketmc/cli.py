@@ -18,7 +18,6 @@ from pathlib import Path
 from . import CORES, __version__
 from .env.atmosphere import MAX_ALTITUDE_M
 from .errors import RocketmcError
-from .files import file_stem
 
 
 class _Parser(argparse.ArgumentParser):
@@ -27,135 +26,61 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _run(args) -> int:
-    from .campaign import run_chunks
+    from .campaign.run import run_campaign
+    from .campaign.runner import run_chunks
 
     controller, sensors = (None if switch is None else switch == "on" for switch in (args.controller, args.sensors))
     campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model,
                          controller=controller, sensors=sensors)  # fmt: skip
-    if args.scheduler is None and args.workers is None:
-        return _fly(args, campaign, run_chunks)
+    realizations = _trajectories(args.trajectories)
+    progress = _progress(args.quiet)
+    options = dict(chunk_size=args.chunk_size, resume=args.resume, force=args.force,
+                   until_converged_pct=args.until_converged, trajectories_of=realizations,
+                   trajectory_interval_s=args.trajectory_interval, progress=progress, warn=lambda line: _warn([line]))  # fmt: skip
     try:
-        from .campaign import distributed as dask
-    except ModuleNotFoundError as e:
-        if e.name not in ("dask", "distributed"):
-            raise
-        raise RocketmcError("--workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')") from None
-    with dask.cluster(args.scheduler, args.workers) as client:
-        return _fly(args, campaign, functools.partial(dask.run_chunks, client), dask.describe(client))
-
-
-def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
-    """Fly ``campaign``'s missing chunks with ``run_chunks`` (``campaign.run_chunks`` or its Dask twin,
-    ``where`` describing the cluster) and write the result file."""
-    from .analysis.ellipse import AreaConvergence
-    from .analysis.flight_record import write_trajectories
-    from .campaign import ResultWriter
-    from .campaign.checks import VALIDITY_OUTPUTS, calibration_warnings, outputs_validity_warnings, stability_warnings
-    from .campaign.runner import chunking
-
-    cfg = campaign.config
-    out = Path(args.out or f"{file_stem(cfg.name)}.h5")
-    if out.is_file() and not (args.resume or args.force):
-        raise RocketmcError(f"--out {out}: the file exists; use --resume to continue it or --force to replace it")
-    chunk_size, n_chunks = chunking(campaign, args.chunk_size)
-    realizations = _trajectories(args.trajectories, campaign)
-    interval = args.trajectory_interval
-    asked = None if realizations is None else {"realizations": realizations, "interval_s": interval}
-    writer = ResultWriter(out, campaign, chunk_size, resume=args.resume, trajectories=asked)
-    if writer.already_complete:
-        print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
-        return 0
-    warnings = stability_warnings(campaign) + calibration_warnings(campaign)
-    _warn(warnings)
-    done = set(writer.completed_chunks())
-    todo = [c for c in range(n_chunks) if c not in done]
-    tty = sys.stderr.isatty() and not args.quiet
-
-    def log(msg, progress=False):
-        """A line on stderr; on a terminal, progress lines overwrite each other in place."""
-        if not args.quiet:
-            print(("\r\033[K" if tty else "") + msg, end="" if progress and tty else "\n", file=sys.stderr, flush=True)
-
-    log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
-        + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
-    if where:
-        log(where)
-    if campaign.gnc_inputs is not None:
-        from .campaign.gains import describe_reference
-
-        log(describe_reference(campaign.gnc_inputs.reference))
-    flown, seconds, failed = 0, 0.0, 0
-    convergence = None if args.until_converged is None else AreaConvergence(args.until_converged / 100.0)
-    if convergence is not None:
-        for index in sorted(done):
-            convergence.add(writer.chunk_outputs(index, ("status", "impact_north_m", "impact_east_m")))
-    if todo and not (convergence and convergence.check()):
-        runs = run_chunks(campaign, chunk_size, chunks=todo)
+        if args.scheduler is None and args.workers is None:
+            run_campaign(campaign, args.out, executor=run_chunks, **options)
+            return 0
         try:
-            log(f"compiled in {next(runs):.1f} s")
-            for i, (index, chunk) in enumerate(zip(todo, runs)):
-                writer.write(chunk, index)
-                flown, seconds = flown + len(chunk.outputs["status"]), seconds + chunk.seconds
-                failed += int((chunk.outputs["status"] != 0).sum())
-                left = (len(todo) - i - 1) * seconds / (i + 1)
-                log(f"chunk {index + 1}/{n_chunks}: {flown} flights this run, {flown / seconds:.0f} flights/s, "
-                    f"ETA {'≤ ' if convergence else ''}{left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
-                if convergence is not None:
-                    convergence.add(chunk.outputs)
-                    if convergence.check():
-                        break
-        except KeyboardInterrupt:
-            log(f"interrupted: the chunks finished are kept in {writer.dir}; the same command with --resume "
-                "completes the run")  # fmt: skip
-            raise
-        finally:
-            runs.close()  # a cluster's chunks still in flight are cancelled
-            if tty:
-                print(file=sys.stderr)  # keep the last progress line
-    n_rows = None
-    if convergence is not None:
-        n_rows = convergence.n
-        state = "converged" if convergence.converged else f"not converged within the {cfg.n_realizations} allowed"
-        log(f"{state} at N = {n_rows}: the 95 % ellipse's area is {convergence.area_m2 / 1e6:.4g} km², its 95 % "
-            f"bootstrap interval {100 * convergence.width:.2f} % of it wide (target {args.until_converged:g} %)")  # fmt: skip
-    validity = []
-
-    def kept_warnings(f):  # the gathered flights' aerodynamic validity, with the stability warnings, in the file
-        validity.extend(outputs_validity_warnings(campaign, {n: f["outputs"][n][()] for n in VALIDITY_OUTPUTS}))
-        return warnings + validity
-
-    rows = n_rows or cfg.n_realizations
-    kept, left = [i for i in realizations or () if i < rows], [i for i in realizations or () if i >= rows]
-    if left:
-        validity.append(f"--trajectories {','.join(map(str, left))}: beyond the {n_rows} realizations --until-converged kept, so not in "
-                        "/trajectories")  # fmt: skip
-    if kept:
-        log(f"trajectories of realizations {', '.join(map(str, kept))}, every {interval:g} s (compiling, then flying "
-            "each)")  # fmt: skip
-    writer.finish(n_rows, kept_warnings, lambda group: write_trajectories(group, campaign, kept, interval))
-    rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
-    log(f"wrote {out} ({flown} flights flown in this run{rate})")
-    _warn(validity)
-    return 0
+            from .campaign import distributed as dask
+        except ModuleNotFoundError as e:
+            if e.name not in ("dask", "distributed"):
+                raise
+            raise RocketmcError("--workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')") from None
+        with dask.cluster(args.scheduler, args.workers) as client:
+            progress(dask.describe(client))
+            run_campaign(campaign, args.out, executor=functools.partial(dask.run_chunks, client), **options)
+        return 0
+    finally:
+        progress.end()
 
 
-def _trajectories(text: str | None, campaign) -> list[int] | None:
-    """The realizations of ``run --trajectories I,J,...``, ascending and once each (None: not given); a one-line
-    RocketmcError for a malformed list, a realization outside the campaign or more than ``MAX_TRAJECTORIES``."""
-    from .analysis.flight_record import check_realization
+class _progress:
+    """Progress lines on stderr (none with --quiet); on a terminal, transient lines overwrite each other in place."""
 
+    def __init__(self, quiet: bool):
+        self.quiet, self.tty, self.open = quiet, sys.stderr.isatty() and not quiet, False
+
+    def __call__(self, line: str, transient: bool = False) -> None:
+        if not self.quiet:
+            self.open = transient and self.tty
+            print(("\r\033[K" if self.tty else "") + line, end="" if self.open else "\n", file=sys.stderr, flush=True)
+
+    def end(self) -> None:
+        """Keep the last transient line."""
+        if self.open:
+            print(file=sys.stderr)
+            self.open = False
+
+
+def _trajectories(text: str | None) -> list[int]:
+    """The realizations of ``run --trajectories I,J,...`` (none: not given); a one-line RocketmcError for a malformed
+    list (the campaign checks the rest, ``run_campaign``)."""
     if text is None:
-        return None
+        return []
     if not re.fullmatch(r"\d+(,\d+)*", text):
         raise RocketmcError(f"--trajectories {text}: expected realization indices separated by commas (0,5,17)")
-    realizations = sorted({int(word) for word in text.split(",")})
-    if len(realizations) > MAX_TRAJECTORIES:
-        raise RocketmcError(f"--trajectories: {len(realizations)} realizations, at most {MAX_TRAJECTORIES} are kept")
-    try:
-        check_realization(campaign, realizations[-1], "--trajectories")
-    except ValueError as e:
-        raise RocketmcError(str(e)) from None
-    return realizations
+    return [int(word) for word in text.split(",")]
 
 
 def _warn(lines: list[str]) -> None:
@@ -478,17 +403,13 @@ def _navigate(args) -> int:
 def _fly_one(args) -> int:
     from .analysis.flight_plots import plot_flight
     from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings
-    from .analysis.flight_record import (
-        OUT_SUFFIXES, check_realization, flight_record, format_record, write_kml, write_series,
-    )  # fmt: skip
+    from .analysis.flight_record import OUT_SUFFIXES, format_record, write_kml, write_series
+    from .campaign.flights import check_realization, flight_record
 
     out = None if args.out is None else _refuse_existing("--out", _output_file("--out", args.out, OUT_SUFFIXES), args.force)
     kml = None if args.kml is None else _refuse_existing("--kml", _output_file("--kml", args.kml, (".kml",)), args.force)
     campaign = _campaign(args.campaign)
-    try:
-        check_realization(campaign, args.realization)
-    except ValueError as e:
-        raise RocketmcError(str(e)) from None
+    check_realization(campaign, args.realization)
     if args.plot_dir:  # before the flight: a folder that cannot be made is said at once
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
@@ -508,12 +429,6 @@ def _fly_one(args) -> int:
 
 MAX_STATIC_S = 86_400.0
 """Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
-MAX_TRAJECTORIES = 100
-"""Most realizations whose trajectories ``run --trajectories`` keeps: with the default interval, 0.1 s, and the
-flights' longest time (``simulation.max_time_s``, 300 s by default) each at most 3002 rows of 43 float64 columns
-(53 with a controller) and the phase, ≤ 1.3 MB."""
-TRAJECTORY_INTERVAL_S = 0.1
-"""The kept trajectories' sample interval by default (``run --trajectory-interval``) [s]."""
 MAX_MACH = 10.0
 """Largest Mach number ``aero derivatives`` evaluates at (tables are clamped at their edge beyond theirs)."""
 FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
@@ -604,6 +519,8 @@ Everywhere else an option has one spelling and one meaning: ``--out``/``--plot``
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``rocketmc`` argument parser with every subcommand."""
+    from .campaign.run import MAX_TRAJECTORIES, TRAJECTORY_INTERVAL_S
+
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
     parser.add_argument("--version", action="version", version=f"rocketmc {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)

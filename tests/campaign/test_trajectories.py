@@ -14,9 +14,9 @@ import pandas as pd
 import pytest
 
 from rocketmc.analysis import format_summary, load_outputs, load_run, load_trajectories, summarize
-from rocketmc.analysis import flight_record as flight_record_module
-from rocketmc.analysis.ellipse import AreaConvergence
-from rocketmc.analysis.flight_record import flight_record
+from rocketmc.campaign import flights as flights_module
+from rocketmc.ellipse import AreaConvergence
+from rocketmc.campaign.flights import flight_record
 from rocketmc.campaign import load_campaign
 from rocketmc.cli import main
 from rocketmc.env import G0
@@ -170,11 +170,11 @@ def test_a_run_killed_while_flying_them_resumes_to_the_same_file(kept, campaign_
         flown.append(index)
         return flight_record(campaign, index)
 
-    monkeypatch.setattr(flight_record_module, "flight_record", interrupted)
+    monkeypatch.setattr(flights_module, "flight_record", interrupted)
     assert main(argv) == 130
     monkeypatch.undo()
     partial = Path(str(out) + ".partial")
-    assert not out.exists() and sorted(p.name for p in partial.iterdir()) == ["chunk_000000.h5", "manifest.json"]
+    assert not out.exists() and sorted(p.name for p in partial.iterdir()) == ["chunk_000000.h5", "manifest.json", "run.lock"]
     capsys.readouterr()
     assert main([*argv[:-2], "--trajectories", "1", "--out", str(out), "--resume"]) == 2  # other trajectories
     assert "(trajectories.realizations differ)" in capsys.readouterr().err and not out.exists()

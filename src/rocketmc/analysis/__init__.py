@@ -1,8 +1,8 @@
 """Post-processing of campaign results: impact ellipses, result files, summaries and plots."""
 
-from .ellipse import Ellipse as Ellipse
-from .ellipse import chi2_scale as chi2_scale
-from .ellipse import confidence_ellipse as confidence_ellipse
+from ..ellipse import Ellipse as Ellipse
+from ..ellipse import chi2_scale as chi2_scale
+from ..ellipse import confidence_ellipse as confidence_ellipse
 from .plots import plot_impacts as plot_impacts
 from .results import SUMMARY_LEVELS as SUMMARY_LEVELS
 from .results import Run as Run

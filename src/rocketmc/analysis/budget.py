@@ -29,7 +29,7 @@ from ..campaign.config import Campaign, CampaignConfig
 from ..campaign.runner import run_chunks
 from ..errors import RocketmcError
 from ..sim.flight import CONTROL_METRICS, NAVIGATION_METRICS
-from .ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
+from ..ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
 
 LEVEL = 0.95
 """Confidence level of the landing ellipses."""

@@ -12,7 +12,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..files import replacing
-from .ellipse import Ellipse, confidence_ellipse
+from ..ellipse import Ellipse, confidence_ellipse
 from .results import Run
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import RocketmcError
-from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse
+from ..ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse
 
 SUMMARY_LEVELS = (0.5, 0.95, 0.99)
 """Confidence levels of the impact ellipses in :func:`summarize`."""
