@@ -29,9 +29,7 @@ def _run(args) -> int:
     from .campaign.run import run_campaign
     from .campaign.runner import run_chunks
 
-    controller, sensors = (None if switch is None else switch == "on" for switch in (args.controller, args.sensors))
-    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model,
-                         controller=controller, sensors=sensors)  # fmt: skip
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, **_switched(args))
     realizations = _trajectories(args.trajectories)
     progress = _progress(args.quiet)
     options = dict(chunk_size=args.chunk_size, resume=args.resume, force=args.force,
@@ -408,7 +406,7 @@ def _fly_one(args) -> int:
 
     out = None if args.out is None else _refuse_existing("--out", _output_file("--out", args.out, OUT_SUFFIXES), args.force)
     kml = None if args.kml is None else _refuse_existing("--kml", _output_file("--kml", args.kml, (".kml",)), args.force)
-    campaign = _campaign(args.campaign)
+    campaign = _campaign(args.campaign, **_switched(args))
     check_realization(campaign, args.realization)
     if args.plot_dir:  # before the flight: a folder that cannot be made is said at once
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
@@ -517,6 +515,24 @@ Everywhere else an option has one spelling and one meaning: ``--out``/``--plot``
 ``--plot-dir`` a folder, ``-n`` realizations, ``--aero-model`` the aerodynamic model(s) (tests/test_cli.py)."""
 
 
+def _flight_switches(parser: argparse.ArgumentParser) -> None:
+    """The options that fly a campaign otherwise: the aerodynamic model, the controller and the sensors."""
+    parser.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
+                        help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    parser.add_argument("--controller", choices=("on", "off"),
+                        help="off: the same flights with the canards neutral (no [gnc]); on: the campaign's [gnc], "
+                             "or its defaults if it has none")  # fmt: skip
+    parser.add_argument("--sensors", choices=("on", "off"),
+                        help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
+                             "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
+
+
+def _switched(args) -> dict:
+    """The campaign overrides of ``_flight_switches``' options (None: the campaign's own)."""
+    on = lambda switch: None if switch is None else switch == "on"  # noqa: E731
+    return {"aero_model": args.aero_model, "controller": on(args.controller), "sensors": on(args.sensors)}
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``rocketmc`` argument parser with every subcommand."""
     from .campaign.run import MAX_TRAJECTORIES, TRAJECTORY_INTERVAL_S
@@ -538,14 +554,7 @@ def build_parser() -> argparse.ArgumentParser:
     replace.add_argument("--force", action="store_true", help="replace an existing result file")
     replace.add_argument("--resume", action="store_true",
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
-    run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
-                     help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
-    run.add_argument("--controller", choices=("on", "off"),
-                     help="off: the same flights with the canards neutral (no [gnc]); on: the campaign's [gnc], "
-                          "or its defaults if it has none")  # fmt: skip
-    run.add_argument("--sensors", choices=("on", "off"),
-                     help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
-                          "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
+    _flight_switches(run)
     run.add_argument("--trajectories", metavar="I,J,...",
                      help=f"keep the time series of these realizations (at most {MAX_TRAJECTORIES}), decimated, in the "
                           "file's /trajectories: each flown after the chunks, bit for bit as fly flies it")  # fmt: skip
@@ -653,6 +662,7 @@ def build_parser() -> argparse.ArgumentParser:
     fly.add_argument("--out", metavar="FLIGHT.csv|.h5", help="write the time series (CSV or HDF5, with units)")
     fly.add_argument("--plot-dir", metavar="DIR", help="folder for the figures (path, altitude and speed, angles, margin)")
     fly.add_argument("--kml", metavar="PATH", help="write the flight path as KML (Google Earth)")
+    _flight_switches(fly)
     fly.add_argument("--force", action="store_true", help="replace existing --out and --kml files")
     fly.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
