@@ -208,49 +208,11 @@ def _rocket_campaign(rocket: str):
 
 
 def _aero_derivatives(args) -> int:
-    from .aero.model import LinearAero, linear_derivatives, simplify
-    from .aero.stability import centre_of_pressure_x_m
-    from .campaign.checks import liftoff_and_burnout_cg_x_m
-    from .campaign.model import nominal_params
+    from .campaign.checks import aero_derivatives, format_aero_derivatives
 
-    campaign = _rocket_campaign(args.rocket)
-    params = nominal_params(campaign)
-    aero = params.rocket.aero
-    linear = aero if isinstance(aero, LinearAero) else simplify(aero)
-    c = linear_derivatives(linear, args.mach, args.altitude)
-    rocket = campaign.config.rocket
-    reference_point = rocket.from_nose(rocket.reference_point_m)  # positions below: from the nose tip
-    d = float(linear.reference_length_m)
-    moment_reference = reference_point - float(linear.moment_ref_x_m)
-    cp = reference_point - centre_of_pressure_x_m(linear, args.mach, args.altitude)
-    cg = {when: reference_point - x for when, x in liftoff_and_burnout_cg_x_m(params).items()}
-    result = {
-        "rocket": args.rocket,
-        "model": campaign.config.rocket.aero.model,
-        "mach": args.mach,
-        "altitude_m": args.altitude,
-        "reference_area_m2": float(linear.reference_area_m2),
-        "reference_length_m": d,
-        "moment_reference_m": moment_reference,
-        "coefficients_per_rad": c,
-        "center_of_pressure_m": cp,
-        "center_of_mass_m": cg,
-        "static_margin_calibers": {when: (cp - x) / d for when, x in cg.items()},
-    }
-    if args.json:
-        print(json.dumps(result, indent=2))
-        return 0
-    print(f"{args.rocket} ({result['model']} model), Mach {args.mach}, altitude {args.altitude:g} m; "
-          f"per rad, moments about {moment_reference:.3f} m from the nose, rates per ω·d/(2V)")  # fmt: skip
-    rows = [("CA0", c["CA0"]), ("CNα", c["CNa"]), ("Cmα", c["Cma"]), ("CNq", c["CNq"]), ("Cmq", c["Cmq"]),
-            ("Clp", c["Clp"]), ("Cl0", c["Cl0"])]  # fmt: skip
-    if linear.n_canards == 4:
-        rows += [("CN_δ (pitch)", c["CN_pitch"]), ("Cm_δ (pitch)", c["Cm_pitch"]), ("Cl_δ (roll)", c["Cl_roll"])]
-    for name, value in rows:
-        print(f"  {name:<14}{value:>10.3f}")
-    print(f"  centre of pressure {cp:.3f} m from the nose tip")
-    for when, x in cg.items():
-        print(f"  {when:<8} CG {x:.3f} m, static margin {(cp - x) / d:.2f} calibers")
+    result = aero_derivatives(_rocket_campaign(args.rocket), args.mach, args.altitude)
+    result = {"rocket": args.rocket, **result}
+    print(json.dumps(result, indent=2) if args.json else format_aero_derivatives(result))
     return 0
 
 
@@ -362,32 +324,8 @@ def _navigate(args) -> int:
         windows = nav_replay.flight_windows(nav, log)
     except ValueError as e:
         raise RocketmcError(f"{args.log_dir}: {e}") from None
-    m = nav_replay.navigation_metrics(nav, log, windows)
-    (burnout, apogee), landing = windows["coast"], windows["descent"][1]
-    top = int(nav["height_m"].idxmax())
-    gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
-    print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
-          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'} ({args.static_source}, "
-          f"σ {float(params.position.altitude_std):g} m"
-          + ("" if args.barometer_max_mach is None else f", locked out above Mach {args.barometer_max_mach:g}")
-          + f"), field direction σ "
-          f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): " + ", ".join(
-              f"{name} {'off' if gate is None else f'{gate:g}'}" for name, gate in
-              (("magnetometer", params.field_gate), ("GNSS", params.gnss_gate), ("barometer", params.altitude_gate))))  # fmt: skip
-    print(f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
-          f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {nav_replay.pad_pressure(nav):.1f} Pa")  # fmt: skip
-    print(f"  rejected by the gates: {nav['rejected_field'].iloc[-1]} magnetometer, {nav['rejected_gnss'].iloc[-1]} "
-          f"GNSS and {nav['rejected_baro'].iloc[-1]} barometer samples")
-    print(f"  estimated apogee {nav['height_m'][top]:.1f} m at {nav['t_s'][top]:.2f} s"
-          + ("; the covariance failed, estimates held from then" if nav["failed"].any() else ""))  # fmt: skip
-    print(f"  {'against the log':<46}{'RMS':>8}{'max':>8}")
-    rows = [("height − barometric height, coast [m]", "height_{}_coast_m"),
-            ("height − barometric height, descent [m]", "height_{}_descent_m"),
-            ("flight-path angle − GNSS's, coast [deg]", "gamma_{}_coast_deg"),
-            ("heading − GNSS's, coast [deg]", "heading_{}_coast_deg"),
-            ("body x axis to GNSS velocity, coast [deg]", "body_to_velocity_{}_coast_deg")]  # fmt: skip
-    for label, key in rows:
-        print(f"  {label:<46}{m[key.format('rms')]:>8.2f}{m[key.format('max')]:>8.2f}")
+    print(nav_replay.format_navigation(nav, log, windows, params, f"{args.log_dir}: the navigation filters of "
+                                       f"{config.name} replayed", args.static_source, args.barometer_max_mach))  # fmt: skip
     if out:
         with replacing(out) as partial:
             nav.to_csv(partial, index=False, lineterminator="\n")
