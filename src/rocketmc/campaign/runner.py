@@ -1,6 +1,7 @@
 """Run a campaign: ``jit(vmap(...))`` over fixed-size chunks of realization indices.
 
-The only place where ``jit`` and ``vmap`` are applied. Every chunk has the same shape (the last one
+Where campaigns are compiled and vmapped (the other modules that apply ``jit`` or ``vmap``: docs/architecture.md,
+"Where jit and vmap sit"). Every chunk has the same shape (the last one
 is padded with indices past N, whose results are dropped), so one compilation serves the run, and
 realization ``i`` gives the same bits whatever the chunk size.
 

@@ -1,6 +1,7 @@
 """One flight, from the rail to the ground: the right-hand side, the control-period step, events.
 
-Single-vehicle and pure; ``campaign.runner`` is the only place that applies ``jit``/``vmap``.
+Single-vehicle and pure: ``jit`` and ``vmap`` are applied by its callers (``campaign.runner`` for campaigns; the
+others in docs/architecture.md, "Where jit and vmap sit").
 Phases are masks, not branches: on the rail, under canopy and on the ground all run the same
 code. Event times are ``inf`` until the event happens.
 """
