@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import math
 import os
 import re
 import signal
@@ -453,6 +454,32 @@ Everywhere else an option has one spelling and one meaning: ``--out``/``--plot``
 ``--plot-dir`` a folder, ``-n`` realizations, ``--aero-model`` the aerodynamic model(s) (tests/test_cli.py)."""
 
 
+def _bounded(kind: type, low: float | None, high: float | None, what: str, above: bool = False):
+    """An argparse type: a finite ``kind`` number from ``low`` (excluded when ``above``) to ``high`` (None: no
+    bound), else the one-line error "must be <what>"."""
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        inside = math.isfinite(value) and (low is None or (value > low if above else value >= low))
+        if not (inside and (high is None or value <= high)):
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text}")
+        return value
+
+    return parse
+
+
+def _positive(what: str):
+    """An argparse type: a positive finite number, said to be a ``what``."""
+    return _bounded(float, 0.0, None, f"a positive {what}", above=True)
+
+
+COUNT = _bounded(int, 1, None, "at least 1")
+PERCENTAGE = _bounded(float, 0.0, 100.0, "a percentage in (0, 100]", above=True)
+
+
 def _flight_switches(parser: argparse.ArgumentParser) -> None:
     """The options that fly a campaign otherwise: the aerodynamic model, the controller and the sensors."""
     parser.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
@@ -480,12 +507,12 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = commands.add_parser("run", help="fly a campaign and write its HDF5 result file")
     run.add_argument("campaign", help="campaign file (TOML)")
-    run.add_argument("-n", type=int, help="number of realizations (overrides the campaign)")
+    run.add_argument("-n", type=COUNT, help="number of realizations (overrides the campaign)")
     run.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
-    run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
+    run.add_argument("--chunk-size", type=COUNT, help="realizations per compiled batch")
     run.add_argument("--quiet", action="store_true", help="no progress messages (errors and warnings only)")
-    run.add_argument("--until-converged", type=float, metavar="PCT",
+    run.add_argument("--until-converged", type=PERCENTAGE, metavar="PCT",
                      help="add chunks (up to N) until the 95 %% ellipse area's 95 %% bootstrap interval is "
                           "narrower than PCT %% of the area; the file keeps the N reached")  # fmt: skip
     replace = run.add_mutually_exclusive_group()
@@ -496,14 +523,14 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--trajectories", metavar="I,J,...",
                      help=f"keep the time series of these realizations (at most {MAX_TRAJECTORIES}), decimated, in the "
                           "file's /trajectories: each flown after the chunks, bit for bit as fly flies it")  # fmt: skip
-    run.add_argument("--trajectory-interval", type=float, default=TRAJECTORY_INTERVAL_S, metavar="S",
+    run.add_argument("--trajectory-interval", type=_positive("time in seconds"), default=TRAJECTORY_INTERVAL_S, metavar="S",
                      help="with --trajectories, keep the first sample of each S seconds and the last (default "
                           "%(default)g)")  # fmt: skip
     cluster = run.add_mutually_exclusive_group()
     cluster.add_argument("--scheduler", metavar="ADDRESS",
                          help="fly the chunks on the Dask cluster of this scheduler (tcp://host:8786; needs "
                               "the 'dask' extra)")  # fmt: skip
-    cluster.add_argument("--workers", type=int, metavar="N",
+    cluster.add_argument("--workers", type=_bounded(int, 1, CORES, f"from 1 to the {CORES} core(s) of this machine (one process per core)"), metavar="N",
                          help="fly the chunks on a local Dask cluster of N worker processes sharing the cores "
                               "(needs the 'dask' extra)")  # fmt: skip
     report = commands.add_parser("report", help="summarize a result file: ellipses and statistics")
@@ -519,7 +546,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--plot-dir", metavar="DIR",
                         help="write histograms of apogee, impact distance from the pad and landing speed (PNG) "
                              "to this folder")  # fmt: skip
-    report.add_argument("--outside-radius", type=float, metavar="M",
+    report.add_argument("--outside-radius", type=_positive("distance in metres"), metavar="M",
                         help="the probability of landing more than M metres from the pad, with its exact 95 %% "
                              "interval (flights without an impact point counted as outside)")  # fmt: skip
     report.add_argument("--outside-polygon", metavar="FILE",
@@ -534,8 +561,8 @@ def build_parser() -> argparse.ArgumentParser:
     aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
     derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")
     derivatives.add_argument("rocket", help="a preset name (lynx) or a campaign file (its rocket)")
-    derivatives.add_argument("--mach", type=float, default=0.3, help="Mach number (default 0.3)")
-    derivatives.add_argument("--altitude", type=float, default=0.0, help="altitude above sea level [m] (default 0)")
+    derivatives.add_argument("--mach", type=_bounded(float, 0.0, MAX_MACH, f"a Mach number in [0, {MAX_MACH:g}]"), default=0.3, help="Mach number (default 0.3)")
+    derivatives.add_argument("--altitude", type=_bounded(float, -2000.0, MAX_ALTITUDE_M, f"in the standard atmosphere's [-2000, {MAX_ALTITUDE_M:.0f}] m"), default=0.0, help="altitude above sea level [m] (default 0)")
     derivatives.add_argument("--json", action="store_true", help="print as JSON")
     gnc = commands.add_parser("gnc", help="the closed loop of a campaign")
     gnc_commands = gnc.add_subparsers(dest="gnc_command", required=True, parser_class=_Parser)
@@ -550,9 +577,9 @@ def build_parser() -> argparse.ArgumentParser:
     simulate = sensors_commands.add_parser(
         "simulate", help="one realization's sensor outputs, as CSV files like the real Lynx log's")
     simulate.add_argument("campaign", help="campaign file (TOML) with an [avionics] section")
-    simulate.add_argument("--realization", type=int, default=0, metavar="I",
+    simulate.add_argument("--realization", type=_bounded(int, 0, None, "at least 0"), default=0, metavar="I",
                           help="the realization whose drawn errors and gusts are flown (default 0)")  # fmt: skip
-    simulate.add_argument("--static", type=float, metavar="SECONDS",
+    simulate.add_argument("--static", type=_bounded(float, 0.0, MAX_STATIC_S, f"a time in (0, {MAX_STATIC_S:g}] s", above=True), metavar="SECONDS",
                           help="instead, the rocket at rest on the pad for this long (noise analysis)")  # fmt: skip
     simulate.add_argument("--out-dir", "--out", dest="out_dir", required=True, metavar="DIR",
                           help="folder for the CSV files (--out: its old spelling)")  # fmt: skip
@@ -572,19 +599,19 @@ def build_parser() -> argparse.ArgumentParser:
                           help="the static pressure of the barometer's samples (the update and the barometric height "
                                "compared with): the log's barometer, or the static port of its pitot_42hz.csv (the "
                                "real log's) (default: baro)")  # fmt: skip
-    navigate.add_argument("--barometer-std", type=float, metavar="M",
+    navigate.add_argument("--barometer-std", type=_positive("height in metres"), metavar="M",
                           help="the barometric height's standard deviation [m] (default: the campaign's)")
-    navigate.add_argument("--barometer-max-mach", type=float, metavar="M",
+    navigate.add_argument("--barometer-max-mach", type=_positive("Mach number"), metavar="M",
                           help="lock the barometer out while the filters' estimated speed exceeds Mach M "
                                "(default: never)")  # fmt: skip
     navigate.add_argument("--gnss", choices=("all", "horizontal"),
                           help="GNSS updates of every axis or of north and east only (default: the campaign's)")  # fmt: skip
-    navigate.add_argument("--gnss-after", type=float, metavar="S",
+    navigate.add_argument("--gnss-after", type=_bounded(float, 0.0, None, "a time of at least 0 s"), metavar="S",
                           help="use GNSS fixes from S seconds after liftoff (default: the campaign's)")  # fmt: skip
-    navigate.add_argument("--gnss-std", type=float, nargs=2, metavar=("M", "MPS"),
+    navigate.add_argument("--gnss-std", type=_positive("standard deviation"), nargs=2, metavar=("M", "MPS"),
                           help="the GNSS's position [m] and velocity [m/s] standard deviations, every axis "
                                "(default: the campaign's)")  # fmt: skip
-    navigate.add_argument("--field-direction-std", type=float, metavar="S",
+    navigate.add_argument("--field-direction-std", type=_positive("standard deviation"), metavar="S",
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
     navigate.add_argument("--initial-attitude", choices=("rail", "accelerometer"), default="rail",
                           help="the attitude at liftoff: the campaign's rail elevation and azimuth, or the pitch and "
@@ -618,7 +645,7 @@ def build_parser() -> argparse.ArgumentParser:
         "flights. One compilation per row flown; no result file.",
     )  # fmt: skip
     budget.add_argument("campaign", help="campaign file (TOML) with [gnc] navigation 'filters' or 'sensors'")
-    budget.add_argument("-n", type=int, help="number of realizations (overrides the campaign)")
+    budget.add_argument("-n", type=COUNT, help="number of realizations (overrides the campaign)")
     budget.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     budget.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                         help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
@@ -637,7 +664,7 @@ def build_parser() -> argparse.ArgumentParser:
         "together. A few minutes with the defaults.",
     )  # fmt: skip
     bench.add_argument("--campaign", metavar="FILE", help="campaign file (default: the built-in lynx_nominal)")
-    bench.add_argument("-n", "--n", dest="n", type=int, nargs="+", default=[1000], metavar="N",
+    bench.add_argument("-n", "--n", dest="n", type=COUNT, nargs="+", default=[1000], metavar="N",
                        help="numbers of realizations, one measurement each (default: 1000)")  # fmt: skip
     bench.add_argument("--aero-model", "--models", dest="aero_model", nargs="+", metavar="MODEL",
                        choices=("simplified", "interpolated", "linear"),
@@ -646,7 +673,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "(default: simplified interpolated)")  # fmt: skip
     bench.add_argument("--precision", nargs="+", choices=("float64", "float32"), metavar="PRECISION",
                        default=["float64", "float32"], help="float64 and/or float32 (default: both)")  # fmt: skip
-    bench.add_argument("--chunk-size", type=int, metavar="C",
+    bench.add_argument("--chunk-size", type=COUNT, metavar="C",
                        help="realizations per compiled chunk (default: the campaign's)")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print the results as JSON instead of a table")
     return parser
@@ -655,33 +682,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.command == "bench" and min(args.n) < 1:
-        parser.error("-n/--n must be at least 1")
-    if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
-        parser.error("--until-converged must be a percentage in (0, 100]")
-    if args.command == "run" and not 0 < args.trajectory_interval < float("inf"):
-        parser.error("--trajectory-interval must be a positive time in seconds")
-    if getattr(args, "outside_radius", None) is not None and not 0 < args.outside_radius < float("inf"):
-        parser.error("--outside-radius must be a positive distance in metres")
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
-    for name in ("n", "chunk_size", "workers") if args.command != "bench" else ("chunk_size",):
-        if getattr(args, name, None) is not None and getattr(args, name) < 1:
-            parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    if (getattr(args, "workers", None) or 0) > CORES:
-        parser.error(f"--workers must be at most the {CORES} core(s) of this machine (one process per core)")
-    if args.command == "sensors" and (args.realization < 0 or not 0 < (args.static or 1.0) <= MAX_STATIC_S):
-        parser.error(f"--realization must be at least 0 and --static in (0, {MAX_STATIC_S:g}] s")
-    if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
-        parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
-                     f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
-    if args.command == "navigate":
-        spreads = [*(args.gnss_std or ()), *(v for v in (args.field_direction_std, args.barometer_std) if v is not None)]
-        if not all(0 < v < float("inf") for v in spreads) or not 0 <= (args.gnss_after or 0.0) < float("inf"):
-            parser.error("--gnss-std, --field-direction-std and --barometer-std must be positive, --gnss-after at "
-                         "least 0")
-        if args.barometer_max_mach is not None and not 0 < args.barometer_max_mach < float("inf"):
-            parser.error("--barometer-max-mach must be a positive Mach number")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget}  # fmt: skip
     try:

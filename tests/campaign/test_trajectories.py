@@ -148,8 +148,8 @@ def exit_code(argv) -> int:
     (["--trajectories", ""], "expected realization indices"),
     (["--trajectories", "2,6"], "--trajectories 6: not a realization of lynx_ballistic (0 to 5)"),
     (["-n", "200", "--trajectories", ",".join(map(str, range(101)))], "101 realizations, at most 100"),
-    (["--trajectories", "1", "--trajectory-interval", "0"], "--trajectory-interval must be a positive time"),
-    (["--trajectories", "1", "--trajectory-interval", "nan"], "--trajectory-interval must be a positive time"),
+    (["--trajectories", "1", "--trajectory-interval", "0"], "argument --trajectory-interval: must be a positive time"),
+    (["--trajectories", "1", "--trajectory-interval", "nan"], "argument --trajectory-interval: must be a positive time"),
 ])  # fmt: skip
 def test_bad_trajectories_exit_2_and_leave_nothing(campaign_file, tmp_path, capsys, options, needle):
     out = tmp_path / "never.h5"
