@@ -35,7 +35,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import PRECISION
+from .runtime import PRECISION
 from .ellipse import confidence_ellipse
 from .campaign import load_campaign, run_chunks
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings

@@ -16,7 +16,7 @@ import signal
 import sys
 from pathlib import Path
 
-from . import CORES, __version__
+from .runtime import CORES, __version__
 from .env.atmosphere import MAX_ALTITUDE_M
 from .errors import RocketmcError
 

@@ -11,4 +11,5 @@ from .results import load_inputs as load_inputs
 from .results import load_outputs as load_outputs
 from .results import load_run as load_run
 from .results import load_trajectories as load_trajectories
+from .results import report as report
 from .results import summarize as summarize

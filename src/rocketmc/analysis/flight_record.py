@@ -11,7 +11,7 @@ from xml.etree import ElementTree
 import numpy as np
 import pandas as pd
 
-from .. import __version__
+from ..runtime import __version__
 from ..campaign.flights import FlightRecord
 from ..campaign.store import write_columns
 from ..env.site import latitude_longitude_deg

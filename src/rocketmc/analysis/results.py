@@ -338,6 +338,12 @@ def _table(header: list[str], rows: list[list[str]], align: str) -> list[str]:
     return [line(header), *(line(r) for r in rows)]
 
 
+def report(run: Run | str | Path) -> str:
+    """What ``rocketmc report`` prints of a result file (a path, or a ``Run`` from ``load_run``): its status counts,
+    metric statistics, ellipses and bootstrap intervals (``format_summary(summarize(run))``)."""
+    return format_summary(summarize(run if isinstance(run, Run) else load_run(run)))
+
+
 def format_summary(summary: dict) -> str:
     """Compact human-readable report of a :func:`summarize` dict."""
     out = [

@@ -30,7 +30,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .. import __version__
+from ..runtime import __version__
 from ..errors import RocketmcError
 from ..files import replacing, replacing_hdf5
 from ..sim.flight import Status, metric
