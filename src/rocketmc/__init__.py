@@ -1,27 +1,47 @@
 """rocketmc: a JAX Monte Carlo dispersion engine for sounding rockets with canard control.
 
-Importing rocketmc sets two JAX options (docs/sharp-bits.md):
-- float64 (``jax_enable_x64``): minutes of flight integrated in thousands of steps, and
-  bit-reproducible campaigns, want it. ``ROCKETMC_PRECISION=float32`` in the environment (read at
-  import) leaves x64 off, for measuring float32 (``rocketmc bench --precision float32``);
-- one XLA CPU device per core (``--xla_force_host_platform_device_count``), unless XLA_FLAGS
-  already chooses, so a campaign chunk runs on every core. It only takes effect if JAX's backend
-  has not started yet.
+Importing rocketmc sets the process's JAX options (``rocketmc.runtime``: float64, one XLA device per core). The
+public API, each name imported from its module on first use (so ``import rocketmc`` loads JAX only)::
+
+    import rocketmc as rmc
+    campaign = rmc.with_overrides(rmc.load_campaign("campaigns/lynx_nominal.toml"), n_realizations=100)
+    path = rmc.run_campaign(campaign, "results/lynx_nominal.h5")
+    print(rmc.report(path))
+
+- ``load_campaign(path)``, ``with_overrides(campaign, ...)``: a campaign file, checked, and the same with options
+  changed (``Campaign``);
+- ``run_campaign(campaign, out, ...)``: fly it into its HDF5 result file;
+- ``load_run(path)``, ``summarize(run)``, ``report(run)``, ``plot_impacts(run, path)``, ``compare(runs)``: read,
+  summarise, print, draw and compare result files;
+- ``flight_record(campaign, realization)``: one flight's full time series;
+- ``RocketmcError``: every error a user can act on, said in one line.
 """
 
-import os
+import importlib
 
-CORES = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-"""The cores this process may run on."""
-if "xla_force_host_platform_device_count" not in os.environ.get("XLA_FLAGS", ""):
-    os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} --xla_force_host_platform_device_count={CORES}".strip()
+from .errors import RocketmcError as RocketmcError
+from .runtime import CORES as CORES
+from .runtime import PRECISION as PRECISION
+from .runtime import __version__ as __version__
 
-import jax  # noqa: E402
+_API = {
+    "Campaign": "campaign", "load_campaign": "campaign", "with_overrides": "campaign",
+    "run_campaign": "campaign.run", "flight_record": "campaign.flights",
+    "load_run": "analysis", "summarize": "analysis", "report": "analysis", "plot_impacts": "analysis",
+    "compare": "analysis.compare",
+}  # fmt: skip
+"""The public names and the module (below ``rocketmc``) each comes from."""
 
-PRECISION = os.environ.get("ROCKETMC_PRECISION", "float64")
-"""``float64`` (the default) or ``float32``, from the environment variable ``ROCKETMC_PRECISION``."""
-if PRECISION not in ("float64", "float32"):
-    raise ValueError(f"ROCKETMC_PRECISION must be float64 or float32, got {PRECISION!r}")
-jax.config.update("jax_enable_x64", PRECISION == "float64")
+__all__ = ["RocketmcError", "__version__", *_API]
 
-__version__ = "0.1.0"
+
+def __getattr__(name: str):
+    if name not in _API:
+        raise AttributeError(f"module 'rocketmc' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{_API[name]}"), name)
+    globals()[name] = value  # imported once
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_API})

@@ -35,8 +35,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import PRECISION
-from .analysis.ellipse import confidence_ellipse
+from .runtime import PRECISION
+from .ellipse import confidence_ellipse
 from .campaign import load_campaign, run_chunks, with_overrides
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings
 from .sim.state import Status

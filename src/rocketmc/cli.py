@@ -9,16 +9,16 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import math
 import os
 import re
 import signal
 import sys
 from pathlib import Path
 
-from . import CORES, __version__
+from .runtime import CORES, __version__
 from .env.atmosphere import MAX_ALTITUDE_M
 from .errors import RocketmcError
-from .files import file_stem
 
 
 class _Parser(argparse.ArgumentParser):
@@ -27,135 +27,59 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _run(args) -> int:
-    from .campaign import run_chunks
+    from .campaign.run import run_campaign
+    from .campaign.runner import run_chunks
 
-    controller, sensors = (None if switch is None else switch == "on" for switch in (args.controller, args.sensors))
-    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, aero_model=args.aero_model,
-                         controller=controller, sensors=sensors)  # fmt: skip
-    if args.scheduler is None and args.workers is None:
-        return _fly(args, campaign, run_chunks)
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, **_switched(args))
+    realizations = _trajectories(args.trajectories)
+    progress = _progress(args.quiet)
+    options = dict(chunk_size=args.chunk_size, resume=args.resume, force=args.force,
+                   until_converged_pct=args.until_converged, trajectories_of=realizations,
+                   trajectory_interval_s=args.trajectory_interval, progress=progress, warn=lambda line: _warn([line]))  # fmt: skip
     try:
-        from .campaign import distributed as dask
-    except ModuleNotFoundError as e:
-        if e.name not in ("dask", "distributed"):
-            raise
-        raise RocketmcError("--workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')") from None
-    with dask.cluster(args.scheduler, args.workers) as client:
-        return _fly(args, campaign, functools.partial(dask.run_chunks, client), dask.describe(client))
-
-
-def _fly(args, campaign, run_chunks, where: str | None = None) -> int:
-    """Fly ``campaign``'s missing chunks with ``run_chunks`` (``campaign.run_chunks`` or its Dask twin,
-    ``where`` describing the cluster) and write the result file."""
-    from .analysis.ellipse import AreaConvergence
-    from .analysis.flight_record import write_trajectories
-    from .campaign import ResultWriter
-    from .campaign.checks import VALIDITY_OUTPUTS, calibration_warnings, outputs_validity_warnings, stability_warnings
-    from .campaign.runner import chunking
-
-    cfg = campaign.config
-    out = Path(args.out or f"{file_stem(cfg.name)}.h5")
-    if out.is_file() and not (args.resume or args.force):
-        raise RocketmcError(f"--out {out}: the file exists; use --resume to continue it or --force to replace it")
-    chunk_size, n_chunks = chunking(campaign, args.chunk_size)
-    realizations = _trajectories(args.trajectories, campaign)
-    interval = args.trajectory_interval
-    asked = None if realizations is None else {"realizations": realizations, "interval_s": interval}
-    writer = ResultWriter(out, campaign, chunk_size, resume=args.resume, trajectories=asked)
-    if writer.already_complete:
-        print(f"{out}: complete already (the same campaign and options); nothing to resume", file=sys.stderr)
-        return 0
-    warnings = stability_warnings(campaign) + calibration_warnings(campaign)
-    _warn(warnings)
-    done = set(writer.completed_chunks())
-    todo = [c for c in range(n_chunks) if c not in done]
-    tty = sys.stderr.isatty() and not args.quiet
-
-    def log(msg, progress=False):
-        """A line on stderr; on a terminal, progress lines overwrite each other in place."""
-        if not args.quiet:
-            print(("\r\033[K" if tty else "") + msg, end="" if progress and tty else "\n", file=sys.stderr, flush=True)
-
-    log(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
-        + (f"; resuming with {len(done)} done" if args.resume else ""))  # fmt: skip
-    if where:
-        log(where)
-    if campaign.gnc_inputs is not None:
-        from .campaign.gains import describe_reference
-
-        log(describe_reference(campaign.gnc_inputs.reference))
-    flown, seconds, failed = 0, 0.0, 0
-    convergence = None if args.until_converged is None else AreaConvergence(args.until_converged / 100.0)
-    if convergence is not None:
-        for index in sorted(done):
-            convergence.add(writer.chunk_outputs(index, ("status", "impact_north_m", "impact_east_m")))
-    if todo and not (convergence and convergence.check()):
-        runs = run_chunks(campaign, chunk_size, chunks=todo)
+        if args.scheduler is None and args.workers is None:
+            run_campaign(campaign, args.out, executor=run_chunks, **options)
+            return 0
         try:
-            log(f"compiled in {next(runs):.1f} s")
-            for i, (index, chunk) in enumerate(zip(todo, runs)):
-                writer.write(chunk, index)
-                flown, seconds = flown + len(chunk.outputs["status"]), seconds + chunk.seconds
-                failed += int((chunk.outputs["status"] != 0).sum())
-                left = (len(todo) - i - 1) * seconds / (i + 1)
-                log(f"chunk {index + 1}/{n_chunks}: {flown} flights this run, {flown / seconds:.0f} flights/s, "
-                    f"ETA {'≤ ' if convergence else ''}{left:.0f} s{f', {failed} not ok' if failed else ''}", progress=True)  # fmt: skip
-                if convergence is not None:
-                    convergence.add(chunk.outputs)
-                    if convergence.check():
-                        break
-        except KeyboardInterrupt:
-            log(f"interrupted: the chunks finished are kept in {writer.dir}; the same command with --resume "
-                "completes the run")  # fmt: skip
-            raise
-        finally:
-            runs.close()  # a cluster's chunks still in flight are cancelled
-            if tty:
-                print(file=sys.stderr)  # keep the last progress line
-    n_rows = None
-    if convergence is not None:
-        n_rows = convergence.n
-        state = "converged" if convergence.converged else f"not converged within the {cfg.n_realizations} allowed"
-        log(f"{state} at N = {n_rows}: the 95 % ellipse's area is {convergence.area_m2 / 1e6:.4g} km², its 95 % "
-            f"bootstrap interval {100 * convergence.width:.2f} % of it wide (target {args.until_converged:g} %)")  # fmt: skip
-    validity = []
-
-    def kept_warnings(f):  # the gathered flights' aerodynamic validity, with the stability warnings, in the file
-        validity.extend(outputs_validity_warnings(campaign, {n: f["outputs"][n][()] for n in VALIDITY_OUTPUTS}))
-        return warnings + validity
-
-    rows = n_rows or cfg.n_realizations
-    kept, left = [i for i in realizations or () if i < rows], [i for i in realizations or () if i >= rows]
-    if left:
-        validity.append(f"--trajectories {','.join(map(str, left))}: beyond the {n_rows} realizations --until-converged kept, so not in "
-                        "/trajectories")  # fmt: skip
-    if kept:
-        log(f"trajectories of realizations {', '.join(map(str, kept))}, every {interval:g} s (compiling, then flying "
-            "each)")  # fmt: skip
-    writer.finish(n_rows, kept_warnings, lambda group: write_trajectories(group, campaign, kept, interval))
-    rate = f", {flown / seconds:.0f} flights/s after compilation" if seconds else ""
-    log(f"wrote {out} ({flown} flights flown in this run{rate})")
-    _warn(validity)
-    return 0
+            from .campaign import distributed as dask
+        except ModuleNotFoundError as e:
+            if e.name not in ("dask", "distributed"):
+                raise
+            raise RocketmcError("--workers/--scheduler need the optional 'dask' extra (pip install 'rocketmc[dask]')") from None
+        with dask.cluster(args.scheduler, args.workers) as client:
+            progress(dask.describe(client))
+            run_campaign(campaign, args.out, executor=functools.partial(dask.run_chunks, client), **options)
+        return 0
+    finally:
+        progress.end()
 
 
-def _trajectories(text: str | None, campaign) -> list[int] | None:
-    """The realizations of ``run --trajectories I,J,...``, ascending and once each (None: not given); a one-line
-    RocketmcError for a malformed list, a realization outside the campaign or more than ``MAX_TRAJECTORIES``."""
-    from .analysis.flight_record import check_realization
+class _progress:
+    """Progress lines on stderr (none with --quiet); on a terminal, transient lines overwrite each other in place."""
 
+    def __init__(self, quiet: bool):
+        self.quiet, self.tty, self.open = quiet, sys.stderr.isatty() and not quiet, False
+
+    def __call__(self, line: str, transient: bool = False) -> None:
+        if not self.quiet:
+            self.open = transient and self.tty
+            print(("\r\033[K" if self.tty else "") + line, end="" if self.open else "\n", file=sys.stderr, flush=True)
+
+    def end(self) -> None:
+        """Keep the last transient line."""
+        if self.open:
+            print(file=sys.stderr)
+            self.open = False
+
+
+def _trajectories(text: str | None) -> list[int]:
+    """The realizations of ``run --trajectories I,J,...`` (none: not given); a one-line RocketmcError for a malformed
+    list (the campaign checks the rest, ``run_campaign``)."""
     if text is None:
-        return None
+        return []
     if not re.fullmatch(r"\d+(,\d+)*", text):
         raise RocketmcError(f"--trajectories {text}: expected realization indices separated by commas (0,5,17)")
-    realizations = sorted({int(word) for word in text.split(",")})
-    if len(realizations) > MAX_TRAJECTORIES:
-        raise RocketmcError(f"--trajectories: {len(realizations)} realizations, at most {MAX_TRAJECTORIES} are kept")
-    try:
-        check_realization(campaign, realizations[-1], "--trajectories")
-    except ValueError as e:
-        raise RocketmcError(str(e)) from None
-    return realizations
+    return [int(word) for word in text.split(",")]
 
 
 def _warn(lines: list[str]) -> None:
@@ -285,49 +209,11 @@ def _rocket_campaign(rocket: str):
 
 
 def _aero_derivatives(args) -> int:
-    from .aero.model import LinearAero, linear_derivatives, simplify
-    from .aero.stability import centre_of_pressure_x_m
-    from .campaign.checks import liftoff_and_burnout_cg_x_m
-    from .campaign.model import nominal_params
+    from .campaign.checks import aero_derivatives, format_aero_derivatives
 
-    campaign = _rocket_campaign(args.rocket)
-    params = nominal_params(campaign)
-    aero = params.rocket.aero
-    linear = aero if isinstance(aero, LinearAero) else simplify(aero)
-    c = linear_derivatives(linear, args.mach, args.altitude)
-    rocket = campaign.config.rocket
-    reference_point = rocket.from_nose(rocket.reference_point_m)  # positions below: from the nose tip
-    d = float(linear.reference_length_m)
-    moment_reference = reference_point - float(linear.moment_ref_x_m)
-    cp = reference_point - centre_of_pressure_x_m(linear, args.mach, args.altitude)
-    cg = {when: reference_point - x for when, x in liftoff_and_burnout_cg_x_m(params).items()}
-    result = {
-        "rocket": args.rocket,
-        "model": campaign.config.rocket.aero.model,
-        "mach": args.mach,
-        "altitude_m": args.altitude,
-        "reference_area_m2": float(linear.reference_area_m2),
-        "reference_length_m": d,
-        "moment_reference_m": moment_reference,
-        "coefficients_per_rad": c,
-        "center_of_pressure_m": cp,
-        "center_of_mass_m": cg,
-        "static_margin_calibers": {when: (cp - x) / d for when, x in cg.items()},
-    }
-    if args.json:
-        print(json.dumps(result, indent=2))
-        return 0
-    print(f"{args.rocket} ({result['model']} model), Mach {args.mach}, altitude {args.altitude:g} m; "
-          f"per rad, moments about {moment_reference:.3f} m from the nose, rates per ω·d/(2V)")  # fmt: skip
-    rows = [("CA0", c["CA0"]), ("CNα", c["CNa"]), ("Cmα", c["Cma"]), ("CNq", c["CNq"]), ("Cmq", c["Cmq"]),
-            ("Clp", c["Clp"]), ("Cl0", c["Cl0"])]  # fmt: skip
-    if linear.n_canards == 4:
-        rows += [("CN_δ (pitch)", c["CN_pitch"]), ("Cm_δ (pitch)", c["Cm_pitch"]), ("Cl_δ (roll)", c["Cl_roll"])]
-    for name, value in rows:
-        print(f"  {name:<14}{value:>10.3f}")
-    print(f"  centre of pressure {cp:.3f} m from the nose tip")
-    for when, x in cg.items():
-        print(f"  {when:<8} CG {x:.3f} m, static margin {(cp - x) / d:.2f} calibers")
+    result = aero_derivatives(_rocket_campaign(args.rocket), args.mach, args.altitude)
+    result = {"rocket": args.rocket, **result}
+    print(json.dumps(result, indent=2) if args.json else format_aero_derivatives(result))
     return 0
 
 
@@ -439,32 +325,8 @@ def _navigate(args) -> int:
         windows = nav_replay.flight_windows(nav, log)
     except ValueError as e:
         raise RocketmcError(f"{args.log_dir}: {e}") from None
-    m = nav_replay.navigation_metrics(nav, log, windows)
-    (burnout, apogee), landing = windows["coast"], windows["descent"][1]
-    top = int(nav["height_m"].idxmax())
-    gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
-    print(f"{args.log_dir}: the navigation filters of {config.name} replayed; GNSS {gnss} from "
-          f"{float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'} ({args.static_source}, "
-          f"σ {float(params.position.altitude_std):g} m"
-          + ("" if args.barometer_max_mach is None else f", locked out above Mach {args.barometer_max_mach:g}")
-          + f"), field direction σ "
-          f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): " + ", ".join(
-              f"{name} {'off' if gate is None else f'{gate:g}'}" for name, gate in
-              (("magnetometer", params.field_gate), ("GNSS", params.gnss_gate), ("barometer", params.altitude_gate))))  # fmt: skip
-    print(f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
-          f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {nav_replay.pad_pressure(nav):.1f} Pa")  # fmt: skip
-    print(f"  rejected by the gates: {nav['rejected_field'].iloc[-1]} magnetometer, {nav['rejected_gnss'].iloc[-1]} "
-          f"GNSS and {nav['rejected_baro'].iloc[-1]} barometer samples")
-    print(f"  estimated apogee {nav['height_m'][top]:.1f} m at {nav['t_s'][top]:.2f} s"
-          + ("; the covariance failed, estimates held from then" if nav["failed"].any() else ""))  # fmt: skip
-    print(f"  {'against the log':<46}{'RMS':>8}{'max':>8}")
-    rows = [("height − barometric height, coast [m]", "height_{}_coast_m"),
-            ("height − barometric height, descent [m]", "height_{}_descent_m"),
-            ("flight-path angle − GNSS's, coast [deg]", "gamma_{}_coast_deg"),
-            ("heading − GNSS's, coast [deg]", "heading_{}_coast_deg"),
-            ("body x axis to GNSS velocity, coast [deg]", "body_to_velocity_{}_coast_deg")]  # fmt: skip
-    for label, key in rows:
-        print(f"  {label:<46}{m[key.format('rms')]:>8.2f}{m[key.format('max')]:>8.2f}")
+    print(nav_replay.format_navigation(nav, log, windows, params, f"{args.log_dir}: the navigation filters of "
+                                       f"{config.name} replayed", args.static_source, args.barometer_max_mach))  # fmt: skip
     if out:
         with replacing(out) as partial:
             nav.to_csv(partial, index=False, lineterminator="\n")
@@ -478,17 +340,13 @@ def _navigate(args) -> int:
 def _fly_one(args) -> int:
     from .analysis.flight_plots import plot_flight
     from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings
-    from .analysis.flight_record import (
-        OUT_SUFFIXES, check_realization, flight_record, format_record, write_kml, write_series,
-    )  # fmt: skip
+    from .analysis.flight_record import OUT_SUFFIXES, format_record, write_kml, write_series
+    from .campaign.flights import check_realization, flight_record
 
     out = None if args.out is None else _refuse_existing("--out", _output_file("--out", args.out, OUT_SUFFIXES), args.force)
     kml = None if args.kml is None else _refuse_existing("--kml", _output_file("--kml", args.kml, (".kml",)), args.force)
-    campaign = _campaign(args.campaign)
-    try:
-        check_realization(campaign, args.realization)
-    except ValueError as e:
-        raise RocketmcError(str(e)) from None
+    campaign = _campaign(args.campaign, **_switched(args))
+    check_realization(campaign, args.realization)
     if args.plot_dir:  # before the flight: a folder that cannot be made is said at once
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
@@ -508,12 +366,6 @@ def _fly_one(args) -> int:
 
 MAX_STATIC_S = 86_400.0
 """Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
-MAX_TRAJECTORIES = 100
-"""Most realizations whose trajectories ``run --trajectories`` keeps: with the default interval, 0.1 s, and the
-flights' longest time (``simulation.max_time_s``, 300 s by default) each at most 3002 rows of 43 float64 columns
-(53 with a controller) and the phase, ≤ 1.3 MB."""
-TRAJECTORY_INTERVAL_S = 0.1
-"""The kept trajectories' sample interval by default (``run --trajectory-interval``) [s]."""
 MAX_MACH = 10.0
 """Largest Mach number ``aero derivatives`` evaluates at (tables are clamped at their edge beyond theirs)."""
 FLIGHTS = {"roccaraso-2021": "lynx_roccaraso_2021.toml", "euroc-2021": "lynx_euroc_2021.toml"}
@@ -602,44 +454,83 @@ Everywhere else an option has one spelling and one meaning: ``--out``/``--plot``
 ``--plot-dir`` a folder, ``-n`` realizations, ``--aero-model`` the aerodynamic model(s) (tests/test_cli.py)."""
 
 
+def _bounded(kind: type, low: float | None, high: float | None, what: str, above: bool = False):
+    """An argparse type: a finite ``kind`` number from ``low`` (excluded when ``above``) to ``high`` (None: no
+    bound), else the one-line error "must be <what>"."""
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        inside = math.isfinite(value) and (low is None or (value > low if above else value >= low))
+        if not (inside and (high is None or value <= high)):
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text}")
+        return value
+
+    return parse
+
+
+def _positive(what: str):
+    """An argparse type: a positive finite number, said to be a ``what``."""
+    return _bounded(float, 0.0, None, f"a positive {what}", above=True)
+
+
+COUNT = _bounded(int, 1, None, "at least 1")
+PERCENTAGE = _bounded(float, 0.0, 100.0, "a percentage in (0, 100]", above=True)
+
+
+def _flight_switches(parser: argparse.ArgumentParser) -> None:
+    """The options that fly a campaign otherwise: the aerodynamic model, the controller and the sensors."""
+    parser.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
+                        help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    parser.add_argument("--controller", choices=("on", "off"),
+                        help="off: the same flights with the canards neutral (no [gnc]); on: the campaign's [gnc], "
+                             "or its defaults if it has none")  # fmt: skip
+    parser.add_argument("--sensors", choices=("on", "off"),
+                        help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
+                             "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
+
+
+def _switched(args) -> dict:
+    """The campaign overrides of ``_flight_switches``' options (None: the campaign's own)."""
+    on = lambda switch: None if switch is None else switch == "on"  # noqa: E731
+    return {"aero_model": args.aero_model, "controller": on(args.controller), "sensors": on(args.sensors)}
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``rocketmc`` argument parser with every subcommand."""
+    from .campaign.run import MAX_TRAJECTORIES, TRAJECTORY_INTERVAL_S
+
     parser = _Parser(prog="rocketmc", description="Monte Carlo dispersion of sounding-rocket flights.")
     parser.add_argument("--version", action="version", version=f"rocketmc {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = commands.add_parser("run", help="fly a campaign and write its HDF5 result file")
     run.add_argument("campaign", help="campaign file (TOML)")
-    run.add_argument("-n", type=int, help="number of realizations (overrides the campaign)")
+    run.add_argument("-n", type=COUNT, help="number of realizations (overrides the campaign)")
     run.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     run.add_argument("--out", help="result file (default: <campaign name>.h5)")
-    run.add_argument("--chunk-size", type=int, help="realizations per compiled batch")
+    run.add_argument("--chunk-size", type=COUNT, help="realizations per compiled batch")
     run.add_argument("--quiet", action="store_true", help="no progress messages (errors and warnings only)")
-    run.add_argument("--until-converged", type=float, metavar="PCT",
+    run.add_argument("--until-converged", type=PERCENTAGE, metavar="PCT",
                      help="add chunks (up to N) until the 95 %% ellipse area's 95 %% bootstrap interval is "
                           "narrower than PCT %% of the area; the file keeps the N reached")  # fmt: skip
     replace = run.add_mutually_exclusive_group()
     replace.add_argument("--force", action="store_true", help="replace an existing result file")
     replace.add_argument("--resume", action="store_true",
                      help="complete the partial run left in OUT.partial/ by a killed run (same campaign and options)")  # fmt: skip
-    run.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
-                     help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
-    run.add_argument("--controller", choices=("on", "off"),
-                     help="off: the same flights with the canards neutral (no [gnc]); on: the campaign's [gnc], "
-                          "or its defaults if it has none")  # fmt: skip
-    run.add_argument("--sensors", choices=("on", "off"),
-                     help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
-                          "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
+    _flight_switches(run)
     run.add_argument("--trajectories", metavar="I,J,...",
                      help=f"keep the time series of these realizations (at most {MAX_TRAJECTORIES}), decimated, in the "
                           "file's /trajectories: each flown after the chunks, bit for bit as fly flies it")  # fmt: skip
-    run.add_argument("--trajectory-interval", type=float, default=TRAJECTORY_INTERVAL_S, metavar="S",
+    run.add_argument("--trajectory-interval", type=_positive("time in seconds"), default=TRAJECTORY_INTERVAL_S, metavar="S",
                      help="with --trajectories, keep the first sample of each S seconds and the last (default "
                           "%(default)g)")  # fmt: skip
     cluster = run.add_mutually_exclusive_group()
     cluster.add_argument("--scheduler", metavar="ADDRESS",
                          help="fly the chunks on the Dask cluster of this scheduler (tcp://host:8786; needs "
                               "the 'dask' extra)")  # fmt: skip
-    cluster.add_argument("--workers", type=int, metavar="N",
+    cluster.add_argument("--workers", type=_bounded(int, 1, CORES, f"from 1 to the {CORES} core(s) of this machine (one process per core)"), metavar="N",
                          help="fly the chunks on a local Dask cluster of N worker processes sharing the cores "
                               "(needs the 'dask' extra)")  # fmt: skip
     report = commands.add_parser("report", help="summarize a result file: ellipses and statistics")
@@ -655,7 +546,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--plot-dir", metavar="DIR",
                         help="write histograms of apogee, impact distance from the pad and landing speed (PNG) "
                              "to this folder")  # fmt: skip
-    report.add_argument("--outside-radius", type=float, metavar="M",
+    report.add_argument("--outside-radius", type=_positive("distance in metres"), metavar="M",
                         help="the probability of landing more than M metres from the pad, with its exact 95 %% "
                              "interval (flights without an impact point counted as outside)")  # fmt: skip
     report.add_argument("--outside-polygon", metavar="FILE",
@@ -670,8 +561,8 @@ def build_parser() -> argparse.ArgumentParser:
     aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
     derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")
     derivatives.add_argument("rocket", help="a preset name (lynx) or a campaign file (its rocket)")
-    derivatives.add_argument("--mach", type=float, default=0.3, help="Mach number (default 0.3)")
-    derivatives.add_argument("--altitude", type=float, default=0.0, help="altitude above sea level [m] (default 0)")
+    derivatives.add_argument("--mach", type=_bounded(float, 0.0, MAX_MACH, f"a Mach number in [0, {MAX_MACH:g}]"), default=0.3, help="Mach number (default 0.3)")
+    derivatives.add_argument("--altitude", type=_bounded(float, -2000.0, MAX_ALTITUDE_M, f"in the standard atmosphere's [-2000, {MAX_ALTITUDE_M:.0f}] m"), default=0.0, help="altitude above sea level [m] (default 0)")
     derivatives.add_argument("--json", action="store_true", help="print as JSON")
     gnc = commands.add_parser("gnc", help="the closed loop of a campaign")
     gnc_commands = gnc.add_subparsers(dest="gnc_command", required=True, parser_class=_Parser)
@@ -686,9 +577,9 @@ def build_parser() -> argparse.ArgumentParser:
     simulate = sensors_commands.add_parser(
         "simulate", help="one realization's sensor outputs, as CSV files like the real Lynx log's")
     simulate.add_argument("campaign", help="campaign file (TOML) with an [avionics] section")
-    simulate.add_argument("--realization", type=int, default=0, metavar="I",
+    simulate.add_argument("--realization", type=_bounded(int, 0, None, "at least 0"), default=0, metavar="I",
                           help="the realization whose drawn errors and gusts are flown (default 0)")  # fmt: skip
-    simulate.add_argument("--static", type=float, metavar="SECONDS",
+    simulate.add_argument("--static", type=_bounded(float, 0.0, MAX_STATIC_S, f"a time in (0, {MAX_STATIC_S:g}] s", above=True), metavar="SECONDS",
                           help="instead, the rocket at rest on the pad for this long (noise analysis)")  # fmt: skip
     simulate.add_argument("--out-dir", "--out", dest="out_dir", required=True, metavar="DIR",
                           help="folder for the CSV files (--out: its old spelling)")  # fmt: skip
@@ -708,19 +599,19 @@ def build_parser() -> argparse.ArgumentParser:
                           help="the static pressure of the barometer's samples (the update and the barometric height "
                                "compared with): the log's barometer, or the static port of its pitot_42hz.csv (the "
                                "real log's) (default: baro)")  # fmt: skip
-    navigate.add_argument("--barometer-std", type=float, metavar="M",
+    navigate.add_argument("--barometer-std", type=_positive("height in metres"), metavar="M",
                           help="the barometric height's standard deviation [m] (default: the campaign's)")
-    navigate.add_argument("--barometer-max-mach", type=float, metavar="M",
+    navigate.add_argument("--barometer-max-mach", type=_positive("Mach number"), metavar="M",
                           help="lock the barometer out while the filters' estimated speed exceeds Mach M "
                                "(default: never)")  # fmt: skip
     navigate.add_argument("--gnss", choices=("all", "horizontal"),
                           help="GNSS updates of every axis or of north and east only (default: the campaign's)")  # fmt: skip
-    navigate.add_argument("--gnss-after", type=float, metavar="S",
+    navigate.add_argument("--gnss-after", type=_bounded(float, 0.0, None, "a time of at least 0 s"), metavar="S",
                           help="use GNSS fixes from S seconds after liftoff (default: the campaign's)")  # fmt: skip
-    navigate.add_argument("--gnss-std", type=float, nargs=2, metavar=("M", "MPS"),
+    navigate.add_argument("--gnss-std", type=_positive("standard deviation"), nargs=2, metavar=("M", "MPS"),
                           help="the GNSS's position [m] and velocity [m/s] standard deviations, every axis "
                                "(default: the campaign's)")  # fmt: skip
-    navigate.add_argument("--field-direction-std", type=float, metavar="S",
+    navigate.add_argument("--field-direction-std", type=_positive("standard deviation"), metavar="S",
                           help="the magnetometer's field direction standard deviation (default: the campaign's)")  # fmt: skip
     navigate.add_argument("--initial-attitude", choices=("rail", "accelerometer"), default="rail",
                           help="the attitude at liftoff: the campaign's rail elevation and azimuth, or the pitch and "
@@ -736,6 +627,7 @@ def build_parser() -> argparse.ArgumentParser:
     fly.add_argument("--out", metavar="FLIGHT.csv|.h5", help="write the time series (CSV or HDF5, with units)")
     fly.add_argument("--plot-dir", metavar="DIR", help="folder for the figures (path, altitude and speed, angles, margin)")
     fly.add_argument("--kml", metavar="PATH", help="write the flight path as KML (Google Earth)")
+    _flight_switches(fly)
     fly.add_argument("--force", action="store_true", help="replace existing --out and --kml files")
     fly.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
     validate = commands.add_parser("validate", help="fly a real flight's campaign and compare with what was measured")
@@ -753,7 +645,7 @@ def build_parser() -> argparse.ArgumentParser:
         "flights. One compilation per row flown; no result file.",
     )  # fmt: skip
     budget.add_argument("campaign", help="campaign file (TOML) with [gnc] navigation 'filters' or 'sensors'")
-    budget.add_argument("-n", type=int, help="number of realizations (overrides the campaign)")
+    budget.add_argument("-n", type=COUNT, help="number of realizations (overrides the campaign)")
     budget.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
     budget.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                         help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
@@ -772,7 +664,7 @@ def build_parser() -> argparse.ArgumentParser:
         "together. A few minutes with the defaults.",
     )  # fmt: skip
     bench.add_argument("--campaign", metavar="FILE", help="campaign file (default: the built-in lynx_nominal)")
-    bench.add_argument("-n", "--n", dest="n", type=int, nargs="+", default=[1000], metavar="N",
+    bench.add_argument("-n", "--n", dest="n", type=COUNT, nargs="+", default=[1000], metavar="N",
                        help="numbers of realizations, one measurement each (default: 1000)")  # fmt: skip
     bench.add_argument("--aero-model", "--models", dest="aero_model", nargs="+", metavar="MODEL",
                        choices=("simplified", "interpolated", "linear"),
@@ -781,7 +673,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "(default: simplified interpolated)")  # fmt: skip
     bench.add_argument("--precision", nargs="+", choices=("float64", "float32"), metavar="PRECISION",
                        default=["float64", "float32"], help="float64 and/or float32 (default: both)")  # fmt: skip
-    bench.add_argument("--chunk-size", type=int, metavar="C",
+    bench.add_argument("--chunk-size", type=COUNT, metavar="C",
                        help="realizations per compiled chunk (default: the campaign's)")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print the results as JSON instead of a table")
     return parser
@@ -790,33 +682,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.command == "bench" and min(args.n) < 1:
-        parser.error("-n/--n must be at least 1")
-    if getattr(args, "until_converged", None) is not None and not 0 < args.until_converged <= 100:
-        parser.error("--until-converged must be a percentage in (0, 100]")
-    if args.command == "run" and not 0 < args.trajectory_interval < float("inf"):
-        parser.error("--trajectory-interval must be a positive time in seconds")
-    if getattr(args, "outside_radius", None) is not None and not 0 < args.outside_radius < float("inf"):
-        parser.error("--outside-radius must be a positive distance in metres")
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
-    for name in ("n", "chunk_size", "workers") if args.command != "bench" else ("chunk_size",):
-        if getattr(args, name, None) is not None and getattr(args, name) < 1:
-            parser.error(f"--{name.replace('_', '-')} must be at least 1")
-    if (getattr(args, "workers", None) or 0) > CORES:
-        parser.error(f"--workers must be at most the {CORES} core(s) of this machine (one process per core)")
-    if args.command == "sensors" and (args.realization < 0 or not 0 < (args.static or 1.0) <= MAX_STATIC_S):
-        parser.error(f"--realization must be at least 0 and --static in (0, {MAX_STATIC_S:g}] s")
-    if args.command == "aero" and not (0 <= args.mach <= MAX_MACH and -2000 <= args.altitude <= MAX_ALTITUDE_M):
-        parser.error(f"--mach must be in [0, {MAX_MACH:g}] and --altitude in the standard atmosphere's "
-                     f"[-2000, {MAX_ALTITUDE_M:.0f}] m")
-    if args.command == "navigate":
-        spreads = [*(args.gnss_std or ()), *(v for v in (args.field_direction_std, args.barometer_std) if v is not None)]
-        if not all(0 < v < float("inf") for v in spreads) or not 0 <= (args.gnss_after or 0.0) < float("inf"):
-            parser.error("--gnss-std, --field-direction-std and --barometer-std must be positive, --gnss-after at "
-                         "least 0")
-        if args.barometer_max_mach is not None and not 0 < args.barometer_max_mach < float("inf"):
-            parser.error("--barometer-max-mach must be a positive Mach number")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget}  # fmt: skip
     try:

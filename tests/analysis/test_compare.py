@@ -14,7 +14,7 @@ from matplotlib.image import imread
 
 from rocketmc.analysis import load_run
 from rocketmc.analysis.compare import area_ratio, compare, format_comparison, unpaired_reason
-from rocketmc.analysis.ellipse import bootstrap_intervals, confidence_ellipse, ellipse_area_m2
+from rocketmc.ellipse import bootstrap_intervals, confidence_ellipse, ellipse_area_m2
 from rocketmc.analysis.plots import plot_comparison
 from rocketmc.campaign import ResultWriter, load_campaign, with_overrides
 from rocketmc.campaign.runner import ChunkResult

@@ -10,8 +10,9 @@ import pytest
 from rocketmc.aero import AirData
 from rocketmc.aero.model import linear_derivatives, simplify
 from rocketmc.aero.stability import centre_of_pressure_at
-from rocketmc.analysis.flight_record import energy_balance, flight_record
+from rocketmc.analysis.flight_record import energy_balance
 from rocketmc.campaign import load_campaign, run_chunks, with_overrides
+from rocketmc.campaign.flights import flight_record
 from rocketmc.campaign.model import nominal_params
 from rocketmc.env import G0
 

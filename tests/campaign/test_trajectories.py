@@ -14,10 +14,10 @@ import pandas as pd
 import pytest
 
 from rocketmc.analysis import format_summary, load_outputs, load_run, load_trajectories, summarize
-from rocketmc.analysis import flight_record as flight_record_module
-from rocketmc.analysis.ellipse import AreaConvergence
-from rocketmc.analysis.flight_record import flight_record
+from rocketmc.campaign import flights as flights_module
 from rocketmc.campaign import load_campaign, with_overrides
+from rocketmc.campaign.flights import flight_record
+from rocketmc.ellipse import AreaConvergence
 from rocketmc.cli import main
 from rocketmc.env import G0
 
@@ -150,8 +150,8 @@ def exit_code(argv) -> int:
     (["--trajectories", ""], "expected realization indices"),
     (["--trajectories", "2,6"], "--trajectories 6: not a realization of lynx_ballistic (0 to 5)"),
     (["-n", "200", "--trajectories", ",".join(map(str, range(101)))], "101 realizations, at most 100"),
-    (["--trajectories", "1", "--trajectory-interval", "0"], "--trajectory-interval must be a positive time"),
-    (["--trajectories", "1", "--trajectory-interval", "nan"], "--trajectory-interval must be a positive time"),
+    (["--trajectories", "1", "--trajectory-interval", "0"], "argument --trajectory-interval: must be a positive time"),
+    (["--trajectories", "1", "--trajectory-interval", "nan"], "argument --trajectory-interval: must be a positive time"),
 ])  # fmt: skip
 def test_bad_trajectories_exit_2_and_leave_nothing(campaign_file, tmp_path, capsys, options, needle):
     out = tmp_path / "never.h5"
@@ -172,11 +172,11 @@ def test_a_run_killed_while_flying_them_resumes_to_the_same_file(kept, campaign_
         flown.append(index)
         return flight_record(campaign, index)
 
-    monkeypatch.setattr(flight_record_module, "flight_record", interrupted)
+    monkeypatch.setattr(flights_module, "flight_record", interrupted)
     assert main(argv) == 130
     monkeypatch.undo()
     partial = Path(str(out) + ".partial")
-    assert not out.exists() and sorted(p.name for p in partial.iterdir()) == ["chunk_000000.h5", "manifest.json"]
+    assert not out.exists() and sorted(p.name for p in partial.iterdir()) == ["chunk_000000.h5", "manifest.json", "run.lock"]
     capsys.readouterr()
     assert main([*argv[:-2], "--trajectories", "1", "--out", str(out), "--resume"]) == 2  # other trajectories
     assert "(trajectories.realizations differ)" in capsys.readouterr().err and not out.exists()

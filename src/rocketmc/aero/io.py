@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from .. import __version__
+from ..runtime import __version__
 from ..files import replacing
 from .datcom import DATCOM_COEFFS, LYNX_DATCOM, DatcomFileError, load_datcom_mat
 from .tables import AXIS_UNITS, BODY_COEFFS, AeroTables, CanardPanels, GriddedCoefficients

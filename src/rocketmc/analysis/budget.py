@@ -33,7 +33,7 @@ from ..campaign.schema import CampaignConfig
 from ..errors import RocketmcError
 from ..gnc.navigation import NavigationMode
 from ..sim.outputs import CONTROL_METRICS, NAVIGATION_METRICS
-from .ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
+from ..ellipse import MIN_BOOTSTRAP_POINTS, confidence_ellipse, ellipse_area_m2, percentile_interval
 
 LEVEL = 0.95
 """Confidence level of the landing ellipses."""

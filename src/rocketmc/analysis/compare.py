@@ -14,7 +14,7 @@ import numpy as np
 
 from ..campaign.schema import FAULT_SECTIONS
 from ..errors import RocketmcError
-from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
+from ..ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
 from .results import Run, _table, navigation_warnings
 
 LEVEL = 0.95

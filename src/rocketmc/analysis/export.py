@@ -12,7 +12,7 @@ import numpy as np
 
 from ..env.site import latitude_longitude_deg
 from ..files import replacing
-from .ellipse import confidence_ellipse
+from ..ellipse import confidence_ellipse
 from .results import SUMMARY_LEVELS, ResultFileError, Run
 
 KML_NAMESPACE = "http://www.opengis.net/kml/2.2"

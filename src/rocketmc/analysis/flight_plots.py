@@ -9,7 +9,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..files import replacing
-from .flight_record import FlightRecord, ascent, events
+from ..campaign.flights import FlightRecord
+from .flight_record import ascent, events
 
 FIGURES = ("path_3d.png", "altitude_speed.png", "angles_of_attack.png", "stability_margin.png")
 _EVENT_COLORS = {"rail exit": "tab:gray", "burnout": "tab:red", "apogee": "tab:green", "impact": "black"}

@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from ..env.weather import geometric_altitude, read_weather
 from ..env.wind import read_wind_profile
 from ..files import replacing
-from .ellipse import Ellipse, confidence_ellipse
+from ..ellipse import Ellipse, confidence_ellipse
 from .results import Run
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")

@@ -324,6 +324,39 @@ def navigation_metrics(nav: pd.DataFrame, log: Mapping[str, pd.DataFrame], windo
 # --- figures -------------------------------------------------------------------------------------------------
 
 
+def format_navigation(nav: pd.DataFrame, log: Mapping[str, pd.DataFrame], windows: Mapping[str, tuple[float, float]],
+                      params: FilterParams, title: str, static_source: str, barometer_max_mach: float | None) -> str:
+    """The replay's report (``rocketmc navigate``): the filters' settings after ``title``, the flight's events as
+    sensed, the gates' rejections, the estimated apogee and ``navigation_metrics`` against the log (RMS and max);
+    ``static_source`` and ``barometer_max_mach`` as the replay was given them."""
+    m = navigation_metrics(nav, log, windows)
+    (burnout, apogee), landing = windows["coast"], windows["descent"][1]
+    top = int(nav["height_m"].idxmax())
+    gnss = "north and east" if params.horizontal_only else "all axes (no altitude in the log)"
+    gates = ", ".join(f"{name} {'off' if gate is None else f'{gate:g}'}" for name, gate in
+                      (("magnetometer", params.field_gate), ("GNSS", params.gnss_gate), ("barometer", params.altitude_gate)))  # fmt: skip
+    lockout = "" if barometer_max_mach is None else f", locked out above Mach {barometer_max_mach:g}"
+    lines = [
+        f"{title}; GNSS {gnss} from {float(params.gnss_after_s):g} s, barometer {'on' if params.barometer else 'off'} "
+        f"({static_source}, σ {float(params.position.altitude_std):g} m{lockout}), field direction σ "
+        f"{float(params.attitude.field_direction_std):g}; innovation gates (χ²): {gates}",
+        f"  liftoff sensed at {nav['t_s'][nav['moving']].iloc[0]:.2f} s, burnout {burnout:.2f} s, apogee "
+        f"{apogee:.2f} s (GNSS), landing {landing:.2f} s; pad pressure {pad_pressure(nav):.1f} Pa",
+        f"  rejected by the gates: {nav['rejected_field'].iloc[-1]} magnetometer, {nav['rejected_gnss'].iloc[-1]} "
+        f"GNSS and {nav['rejected_baro'].iloc[-1]} barometer samples",
+        f"  estimated apogee {nav['height_m'][top]:.1f} m at {nav['t_s'][top]:.2f} s"
+        + ("; the covariance failed, estimates held from then" if nav["failed"].any() else ""),
+        f"  {'against the log':<46}{'RMS':>8}{'max':>8}",
+    ]  # fmt: skip
+    rows = [("height − barometric height, coast [m]", "height_{}_coast_m"),
+            ("height − barometric height, descent [m]", "height_{}_descent_m"),
+            ("flight-path angle − GNSS's, coast [deg]", "gamma_{}_coast_deg"),
+            ("heading − GNSS's, coast [deg]", "heading_{}_coast_deg"),
+            ("body x axis to GNSS velocity, coast [deg]", "body_to_velocity_{}_coast_deg")]  # fmt: skip
+    lines += [f"  {label:<46}{m[key.format('rms')]:>8.2f}{m[key.format('max')]:>8.2f}" for label, key in rows]
+    return "\n".join(lines)
+
+
 def _panels(rows: int, title: str, height: float = 2.6) -> tuple[Figure, np.ndarray]:
     fig = Figure(figsize=(11.0, height * rows + 0.7), layout="constrained")
     fig.suptitle(title)

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import RocketmcError
-from .ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse
+from ..ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse
 
 SUMMARY_LEVELS = (0.5, 0.95, 0.99)
 """Confidence levels of the impact ellipses in :func:`summarize`."""
@@ -336,6 +336,12 @@ def _table(header: list[str], rows: list[list[str]], align: str) -> list[str]:
         ).rstrip()
 
     return [line(header), *(line(r) for r in rows)]
+
+
+def report(run: Run | str | Path) -> str:
+    """What ``rocketmc report`` prints of a result file (a path, or a ``Run`` from ``load_run``): its status counts,
+    metric statistics, ellipses and bootstrap intervals (``format_summary(summarize(run))``)."""
+    return format_summary(summarize(run if isinstance(run, Run) else load_run(run)))
 
 
 def format_summary(summary: dict) -> str:

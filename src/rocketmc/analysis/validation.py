@@ -1,65 +1,17 @@
-"""The nominal flight of a campaign as its sensors would see it, for comparison with a flight log.
-
-Times are from motor ignition [s] (the log's liftoff sample: the L1350 lifts the rocket within a
-sample of lighting); heights above the pad [m]; the specific force along the body x axis [m/s²]
-is what an accelerometer on the axis reads (on the rail too).
-"""
+"""The nominal flight of a campaign (``campaign.flights.simulated_flight``: as its sensors would see it) against a
+real flight's log: the checks of ``rocketmc validate`` and their figure."""
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-import jax
-import jax.numpy as jnp
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from ..campaign import Campaign, nominal_params
-from ..campaign.runner import sim_settings
-from ..env import G0, isa
-from ..math import Vec3
-from ..sim.flight import fly
-from ..sim.loads import derivatives
-from ..sim.outputs import flight_summary
+from ..campaign import Campaign
+from ..campaign.flights import simulated_flight
 from .flight_log import FlightReduction
-
-
-def simulated_flight(campaign: Campaign, duration_s: float = 150.0) -> tuple[pd.DataFrame, dict, int]:
-    """The campaign's nominal flight sampled every control period until ``duration_s`` after ignition
-    or the impact: a DataFrame (``t_s``, ``altitude_agl_m``, ``vertical_speed_mps``, ``airspeed_mps``,
-    ``axial_specific_force_mps2``), the summary (times from ignition) and the status code."""
-    params = nominal_params(campaign)
-    settings = sim_settings(campaign)
-    ignition = float(params.rocket.motor.ignition_time_s)
-    n_periods = int(np.ceil((duration_s + ignition) / settings.control_dt_s))
-
-    def sensed(p):
-        final, trajectory = fly(p, settings, n_periods)
-        neutral = jnp.zeros(p.rocket.aero.n_canards)
-
-        def at(state):
-            d_body, diagnostics = derivatives(state.t, state.body, p, neutral, Vec3.zeros(state.t), state.events)
-            gravity_free = d_body.v_n - Vec3(0.0, 0.0, G0)
-            return state.body.q_nb.rotate_inverse(gravity_free).x, diagnostics.mach
-
-        force, mach = jax.vmap(at)(trajectory)
-        return final, trajectory, force, mach
-
-    final, trajectory, force, mach = jax.jit(sensed)(params)
-    summary, status = flight_summary(params, final)
-    altitude = -np.asarray(trajectory.body.r_n.z)
-    speed_of_sound = np.asarray(isa(float(params.environment.site_altitude_m) + altitude).speed_of_sound)
-    flight = pd.DataFrame({
-        "t_s": np.asarray(trajectory.t) - ignition,
-        "altitude_agl_m": altitude,
-        "vertical_speed_mps": -np.asarray(trajectory.body.v_n.z),
-        "airspeed_mps": np.asarray(mach) * speed_of_sound,
-        "axial_specific_force_mps2": np.asarray(force),
-    })  # fmt: skip
-    times = {k: float(v) - ignition if k.endswith("time_s") else float(v) for k, v in summary.items()}
-    until = min(duration_s, times["impact_time_s"]) if np.isfinite(times["impact_time_s"]) else duration_s
-    return flight[flight.t_s <= until].reset_index(drop=True), times, int(status)
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,8 @@ import math
 import numpy as np
 
 from ..aero.buildup import MAX_SUBSONIC_MACH
-from ..aero.model import LinearAero
-from ..aero.stability import static_margin_calibers
+from ..aero.model import LinearAero, linear_derivatives, simplify
+from ..aero.stability import centre_of_pressure_x_m, static_margin_calibers
 from ..gnc.navigation import NavigationMode
 from ..sim.loads import mass_properties
 from ..sim.params import FlightParams
@@ -126,3 +126,47 @@ def outputs_validity_warnings(campaign: Campaign, outputs) -> list[str]:
     outside = int((values["max_dynamic_pressure_outside_aero_tables_pa"] > OUTSIDE_TABLES_QBAR_FRACTION * qbar).sum())
     return aero_validity_warnings(campaign, top(values["max_mach"]),
                                   top(values["apogee_agl_m"]) + campaign.config.site.altitude_m, outside)  # fmt: skip
+
+
+def aero_derivatives(campaign: Campaign, mach: float, altitude_m: float) -> dict:
+    """The linear aerodynamic derivatives of ``campaign``'s rocket (its model, simplified if it is a table) at
+    ``mach`` and ``altitude_m`` [m], with its centre of pressure, CG and static margin at liftoff and at burnout
+    (``rocketmc aero derivatives``). Positions are distances from the nose tip [m]; coefficients per rad, rates per
+    ω·d/(2V)."""
+    params = nominal_params(campaign)
+    aero = params.rocket.aero
+    linear = aero if isinstance(aero, LinearAero) else simplify(aero)
+    c = linear_derivatives(linear, mach, altitude_m)
+    rocket = campaign.config.rocket
+    reference_point = rocket.from_nose(rocket.reference_point_m)  # positions below: from the nose tip
+    d = float(linear.reference_length_m)
+    cp = reference_point - centre_of_pressure_x_m(linear, mach, altitude_m)
+    cg = {when: reference_point - x for when, x in liftoff_and_burnout_cg_x_m(params).items()}
+    return {
+        "model": rocket.aero.model,
+        "mach": mach,
+        "altitude_m": altitude_m,
+        "reference_area_m2": float(linear.reference_area_m2),
+        "reference_length_m": d,
+        "moment_reference_m": reference_point - float(linear.moment_ref_x_m),
+        "n_canards": int(linear.n_canards),
+        "coefficients_per_rad": c,
+        "center_of_pressure_m": cp,
+        "center_of_mass_m": cg,
+        "static_margin_calibers": {when: (cp - x) / d for when, x in cg.items()},
+    }
+
+
+def format_aero_derivatives(result: dict) -> str:
+    """``aero_derivatives``' result (with the ``rocket`` it names) as a table."""
+    c, cp, d = result["coefficients_per_rad"], result["center_of_pressure_m"], result["reference_length_m"]
+    lines = [f"{result['rocket']} ({result['model']} model), Mach {result['mach']}, altitude {result['altitude_m']:g} m; "
+             f"per rad, moments about {result['moment_reference_m']:.3f} m from the nose, rates per ω·d/(2V)"]  # fmt: skip
+    rows = [("CA0", c["CA0"]), ("CNα", c["CNa"]), ("Cmα", c["Cma"]), ("CNq", c["CNq"]), ("Cmq", c["Cmq"]),
+            ("Clp", c["Clp"]), ("Cl0", c["Cl0"])]  # fmt: skip
+    if result["n_canards"] == 4:
+        rows += [("CN_δ (pitch)", c["CN_pitch"]), ("Cm_δ (pitch)", c["Cm_pitch"]), ("Cl_δ (roll)", c["Cl_roll"])]
+    lines += [f"  {name:<14}{value:>10.3f}" for name, value in rows]
+    lines.append(f"  centre of pressure {cp:.3f} m from the nose tip")
+    lines += [f"  {when:<8} CG {x:.3f} m, static margin {(cp - x) / d:.2f} calibers" for when, x in result["center_of_mass_m"].items()]
+    return "\n".join(lines)

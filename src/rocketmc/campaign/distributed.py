@@ -33,7 +33,7 @@ import jax
 from distributed import Client, KilledWorker, LocalCluster
 from distributed.comm import CommClosedError
 
-from .. import __version__
+from ..runtime import __version__
 from ..errors import RocketmcError
 from .record import Campaign
 from .fingerprint import differences, setup

@@ -19,7 +19,7 @@ from importlib import metadata
 import jax
 import numpy as np
 
-from .. import PRECISION, __version__
+from ..runtime import PRECISION, __version__
 from .record import Campaign
 
 PACKAGES = ("jax", "jaxlib", "numpy", "scipy")

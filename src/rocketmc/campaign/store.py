@@ -12,12 +12,16 @@ against the set-up given: a manifest of another set-up or edited by hand, a chun
 one renamed, truncated or damaged, or a file that is not the run's are refused in one line, and
 nothing is overwritten.
 A run that keeps trajectories (``rocketmc run --trajectories``) says which in its manifest (a resume must ask for
-the same) and flies them in ``finish()``, into the file before it is marked complete: a run killed while flying
+the same) and writes them in ``finish()``, into the file before it is marked complete: a run killed while flying
 them keeps its chunks and resumes to fly them again.
+One run at a time writes a partial folder: the writer holds an exclusive lock (``flock``) on its ``run.lock`` from
+the start to the end, which the system releases when the process ends, however it ends; a second run on the same
+folder is refused in one line.
 """
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import re
@@ -26,16 +30,19 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .. import __version__
+from ..runtime import __version__
 from ..errors import RocketmcError
 from ..files import replacing, replacing_hdf5
 from ..sim.outputs import metric
 from ..sim.state import Status
 from .record import Campaign
 from .fingerprint import differences, fingerprint, setup
+from .flights import TRAJECTORY_RULE
 from .runner import ChunkResult, chunking
 
 MANIFEST = "manifest.json"
+LOCK = "run.lock"
+"""The partial folder's lock file: held (``flock``) by the run writing the folder."""
 MANIFEST_FORMAT = 2
 """Version of the partial folder's layout: 2 since the set-up fingerprint (rocketmc 0.1)."""
 CHUNK_FILE = re.compile(r"chunk_(\d{6})\.h5")
@@ -99,26 +106,59 @@ class ResultWriter:
         self._names: dict[str, set[str]] | None = None  # the datasets of every chunk, from the first checked
         if self.out.is_dir():
             raise WriteError(f"{self.out}: is a folder, expected a result file name")
+        self._lock_file = None
         if resume:
             if not self.dir.exists() and self.out.is_file():
                 self._check_complete_result()
                 self.already_complete = True
                 return
-            self._check_manifest(_read_manifest(self.dir / MANIFEST))
-            for index in self._listed_chunks():
-                self._read_chunk(index)
-                self._chunks.add(index)
+            self._lock()
+            try:
+                self._check_manifest(_read_manifest(self.dir / MANIFEST))
+                for index in self._listed_chunks():
+                    self._read_chunk(index)
+                    self._chunks.add(index)
+            except ResumeError:
+                self.close()
+                raise
         else:
             if self.dir.exists():
+                self._lock()  # another run writing it is said first
+                self.close()
                 raise ResumeError(f"{self.dir}: a partial run is there already; resume it with --resume or delete it")
             try:
                 self.dir.mkdir(parents=True)
+                self._lock()
                 with replacing(self.dir / MANIFEST) as path:
                     path.write_text(json.dumps(self.manifest, indent=1))
             except OSError as e:
+                self.close()
+                (self.dir / LOCK).unlink(missing_ok=True)
                 if self.dir.is_dir() and not any(self.dir.iterdir()):
                     self.dir.rmdir()
                 raise WriteError(f"{e.filename or self.dir}: could not start the run ({e.strerror or e})") from None
+
+    def _lock(self) -> None:
+        """Hold the partial folder's lock, or refuse in one line while another run holds it (no folder: nothing to
+        hold, the checks that follow say so)."""
+        if not self.dir.is_dir():
+            return
+        try:
+            self._lock_file = open(self.dir / LOCK, "a")
+        except OSError as e:
+            raise WriteError(f"{self.dir / LOCK}: could not open ({e.strerror or e})") from None
+        try:
+            fcntl.flock(self._lock_file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            self.close()
+            raise ResumeError(f"{self.dir}: in use by another rocketmc run writing it; wait for that run to end (or "
+                              "stop it), then --resume") from None  # fmt: skip
+
+    def close(self) -> None:
+        """Release the partial folder's lock (the end of the process releases it too)."""
+        if self._lock_file is not None:
+            self._lock_file.close()
+            self._lock_file = None
 
     def _check_complete_result(self) -> None:
         """Resuming with no partial folder: ``out`` must be a complete result file of this set-up."""
@@ -159,7 +199,7 @@ class ResultWriter:
         indices = []
         for path in sorted(self.dir.iterdir()):
             match = CHUNK_FILE.fullmatch(path.name)
-            if path.name == MANIFEST or (path.name.endswith(".writing") and path.is_file()):
+            if path.name in (MANIFEST, LOCK) or (path.name.endswith(".writing") and path.is_file()):
                 continue  # .writing: a write cut short by a kill, replaced when its chunk is written
             if match is None or not path.is_file():
                 raise ResumeError(f"{path}: not a file of a rocketmc partial run; move it out of {self.dir.name} "
@@ -224,13 +264,14 @@ class ResultWriter:
         with h5py.File(self._chunk_path(index), "r") as chunk:
             return {name: chunk["outputs"][name][()] for name in names}
 
-    def finish(self, n_rows: int | None = None, warnings=None, write_trajectories=None) -> Path:
+    def finish(self, n_rows: int | None = None, warnings=None, trajectories=None) -> Path:
         """Check the chunks and gather them into ``<out>`` (complete), then remove the partial folder.
         ``n_rows``: the realizations kept when a run stopped early (``--until-converged``), the first
         chunks' rows; ``warnings``: a function of the gathered file returning warning lines, kept in its
-        ``warnings`` attribute (a JSON list) before the file is marked complete; ``write_trajectories``: with
-        ``trajectories`` asked for, a function writing them into the group ``/trajectories`` it is given (whose
-        ``realizations`` and ``interval_s`` attributes say what was asked for), before the file is marked complete."""
+        ``warnings`` attribute (a JSON list) before the file is marked complete; ``trajectories``: with trajectories asked
+        for, a function returning each kept flight's (record, samples before decimation), ``campaign.flights.
+        trajectories``, written to ``/trajectories/<index>`` (one dataset per column with ``unit`` and ``description``;
+        ``status``, ``status_message`` and ``samples`` as attributes) before the file is marked complete."""
         if self.already_complete:
             return self.out
         n = self.n if n_rows is None else n_rows
@@ -260,15 +301,21 @@ class ResultWriter:
                     group = f.create_group(TRAJECTORIES)
                     group.attrs.update({"realizations": np.asarray(self.trajectories["realizations"], dtype=np.int64),
                                         "interval_s": self.trajectories["interval_s"]})  # fmt: skip
-                    write_trajectories(group)
+                    group.attrs["description"] = TRAJECTORY_RULE
+                    for record, samples in trajectories():
+                        g = group.create_group(str(record.realization), track_order=True)
+                        g.attrs.update({"status": record.status, "status_message": Status(record.status).message,
+                                        "samples": samples})  # fmt: skip
+                        write_columns(g, record.series, record.columns)
                 if warnings is not None:
                     f.attrs["warnings"] = json.dumps(warnings(f))
                 f.attrs["complete"] = True
         except OSError as e:
             raise WriteError(f"{self.out}: could not write ({e.strerror or e}); all {_plural(len(needed), 'chunk')} are "
                              f"kept in {self.dir}: free space and run the same command with --resume") from None  # fmt: skip
-        for path in [self.dir / MANIFEST, *map(self._chunk_path, self._chunks)]:
+        for path in [self.dir / MANIFEST, *map(self._chunk_path, self._chunks), self.dir / LOCK]:
             path.unlink()
+        self.close()
         try:
             self.dir.rmdir()
         except OSError:  # a file put there since the checks: the user's, kept
@@ -286,3 +333,12 @@ class ResultWriter:
             if name == "status":
                 ds.attrs["codes"] = json.dumps({str(int(s)): s.message for s in Status})
         return g[name]
+
+
+def write_columns(group: h5py.Group, series, columns: dict) -> None:
+    """Each column of the DataFrame ``series`` as a dataset of ``group`` (strings as bytes) with the ``unit`` and
+    ``description`` of its ``Metric`` in ``columns``."""
+    for name, m in columns.items():
+        values = series[name].to_numpy()
+        data = group.create_dataset(name, data=values.astype("S") if values.dtype == object else values)
+        data.attrs.update({"unit": m.unit, "description": m.meaning})

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rocketmc.analysis import Ellipse, chi2_scale, confidence_ellipse
-from rocketmc.analysis.ellipse import bootstrap_intervals, ellipse_area_m2
+from rocketmc.ellipse import bootstrap_intervals, ellipse_area_m2
 
 N_BIG = 200_000
 # True impact distribution (north, east) [m]: std 250 m along azimuth 30 deg, 80 m across.
