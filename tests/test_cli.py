@@ -156,13 +156,13 @@ def test_until_converged_stops_by_itself(tmp_path, capsys):
     assert info.value.code == 2
 
 
-README = Path(__file__).parents[1] / "README.md"
+README = Path(__file__).parents[1] / "docs" / "guide.md"
 OPTION = re.compile(r"(?<![\w-])--?[a-z][a-z0-9-]*")  # -n, --chunk-size; not the -2021 of roccaraso-2021
 
 
 def _readme_commands():
-    """{subcommand words: (options, {option or positional: choices})} of README's "Using it" block."""
-    block = README.read_text().split("## Using it", 1)[1].split("```sh", 1)[1].split("```", 1)[0]
+    """{subcommand words: (options, {option or positional: choices})} of the guide's "The commands" block."""
+    block = README.read_text().split("## The commands", 1)[1].split("```sh", 1)[1].split("```", 1)[0]
     commands = {}
     for text in re.split(r"\n(?=rocketmc )", block.strip()):
         tokens = text.split()[1:]
@@ -184,7 +184,7 @@ def _help(capsys, *words):
 
 
 def test_help_matches_the_readme(capsys):
-    """`--help` of the program and of each subcommand against README's "Using it" block: the same
+    """`--help` of the program and of each subcommand against the guide's "The commands" block: the same
     subcommands, and for each the same options (both ways: an option dropped from the parser or one
     added without the README saying so fails) and the same choices where the README lists them."""
     documented = _readme_commands()
