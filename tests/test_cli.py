@@ -83,7 +83,7 @@ def test_bad_arguments_exit_2(tmp_path, capsys):
     assert main(["run", str(tmp_path / "missing.toml")]) == 2
     assert main(["report", str(tmp_path / "missing.h5")]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 3 and "--n" in lines[0] and all("not found" in line for line in lines[1:]), lines
+    assert len(lines) == 3 and "argument -n" in lines[0] and all("not found" in line for line in lines[1:]), lines
 
 
 def test_aero_derivatives(capsys):

@@ -87,6 +87,7 @@ def resumes(address: str, path: str, campaign, want: dict, out) -> None:
         rows = slice(CHUNK * index, CHUNK * (index + 1))
         part = {group: {k.split("/")[1]: v[rows] for k, v in want.items() if k.startswith(group)} for group in ("outputs", "inputs")}
         writer.write(ChunkResult(CHUNK * index, part["outputs"], part["inputs"], 0.0), index)
+    writer.close()  # the killed run's lock is gone with its process
     assert main(["run", path, *ARGS, "--out", str(out), "--quiet", "--resume", "--scheduler", address]) == 0
     assert_same(contents(out)[0], want)
 

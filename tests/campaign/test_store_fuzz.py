@@ -327,7 +327,7 @@ def test_a_full_disk_ends_in_one_line_and_resume_completes(flown, tmp_path, caps
     file_size_limit(resource.RLIM_INFINITY)
     partial = Path(f"{out}.partial")
     assert f"{chunks_kept} chunk" in line and not out.exists()
-    assert sorted(p.name for p in partial.iterdir()) == sorted(["manifest.json", *(f"chunk_{i:06d}.h5" for i in range(chunks_kept))])
+    assert sorted(p.name for p in partial.iterdir()) == sorted(["manifest.json", "run.lock", *(f"chunk_{i:06d}.h5" for i in range(chunks_kept))])
     assert main([*argv, "--resume"]) == 0
     assert_same(contents(out)[0], contents(reference)[0])
 

@@ -19,6 +19,7 @@ from rocketmc.gnc import design
 from rocketmc.gnc import control
 from rocketmc.gnc.control import GAIN_NAMES, GncParams, GncState, control_summary, gains_at, initial_gnc, lqi_command
 from rocketmc.gnc.guidance import Navigation
+from rocketmc.gnc.navigation import NavigationMode
 from rocketmc.math import Quat, Vec3
 from rocketmc.math.table import Table
 
@@ -57,7 +58,7 @@ def params(schedule):
     table = Table.from_numpy((SPEEDS, ALTITUDES), schedule.gains.reshape(4, 2, -1), ("speed", "altitude"), GAIN_NAMES)
     servo = ServoParams(jnp.asarray(0.0769), jnp.asarray(LIMIT), jnp.zeros(4))
     guidance = THESIS
-    return GncParams(servo, guidance, table, anti_windup=True, navigation="truth")
+    return GncParams(servo, guidance, table, anti_windup=True, navigation=NavigationMode.TRUTH)
 
 
 def flying(speed=100.0, pitch_deg=80.0, omega=Vec3(0.0, 0.0, 0.0)) -> Navigation:

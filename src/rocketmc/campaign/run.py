@@ -69,7 +69,8 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
     trajectories_of: realizations whose time series the file keeps, decimated to ``trajectory_interval_s`` [s];
     executor: flies chunks, ``runner.run_chunks`` or ``distributed.run_chunks`` bound to a Dask client;
     progress(line, transient): progress lines (transient ones may be overwritten by the next);
-    warn(line): the campaign's and the flights' warnings (by default Python warnings of ``RunWarning``).
+    warn(line): the campaign's and the flights' warnings, and a resume with nothing left to fly (by default
+    Python warnings of ``RunWarning``).
     Raises RocketmcError (one line) for what cannot be run or written; a killed run keeps its finished chunks.
     """
     cfg = campaign.config
@@ -82,7 +83,7 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
     writer = ResultWriter(out, campaign, chunk_size, resume=resume, trajectories=asked)
     try:
         if writer.already_complete:
-            progress(f"{out}: complete already (the same campaign and options); nothing to resume")
+            warn(f"{out}: complete already (the same campaign and options); nothing to resume")
             return out
         return _fly(campaign, writer, executor, until_converged_pct, kept, trajectory_interval_s, progress, warn)
     finally:
