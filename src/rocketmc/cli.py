@@ -219,36 +219,14 @@ def _aero_derivatives(args) -> int:
 
 def _gnc_design(args) -> int:
     from .analysis.plots import plot_gains
-    from .campaign.gains import describe_reference, schedule_summary
+    from .campaign.gains import format_schedule, schedule_summary
 
     plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
     campaign = _campaign(args.campaign, aero_model=args.aero_model)
     if campaign.gnc_schedule is None:
         raise RocketmcError(f"{args.campaign}: no [gnc] section, so no gains to design")
     summary = schedule_summary(campaign.config, campaign.gnc_schedule, campaign.gnc_inputs)
-    if args.json:
-        print(json.dumps(summary, indent=2))
-    else:
-        mass, window = summary["burnout"], summary["window_estimate"]
-        print(f"{summary['campaign']}: LQI gains ({summary['aero_model']} aerodynamics), {summary['discretisation']} "
-              f"over dt {summary['dt_s']:g} s, Q = diag{tuple(summary['q_weights'])}, R = diag{tuple(summary['r_weights'])}, "
-              f"integrator gains {tuple(summary['integrator_gain'])}")
-        print(f"  plant at burnout: mass {mass['mass_kg']:.3f} kg, CG x {mass['cg_x_m']:+.3f} m (body, from the "
-              f"reference point), Ixx {mass['ixx_kgm2']:.4g}, Iyy {mass['iyy_kgm2']:.4g} kg·m²; "
-              f"servo {summary['servo_bandwidth_rad_s']:.2f} rad/s")
-        print(f"  guidance window (nominal flight, point-mass estimate): {window['speed_mps'][0]:.0f} to "
-              f"{window['speed_mps'][1]:.0f} m/s, {window['altitude_agl_m'][0]:.0f} to {window['altitude_agl_m'][1]:.0f} m above the pad")
-        print(f"  {describe_reference(campaign.gnc_inputs.reference)}")
-        names = [name for gains in ("pitch", "roll") for name in summary["points"][0][gains]]
-        flown = max(p["flown_spectral_radius"] for p in summary["points"])
-        print(f"  spectral radius of the loop as flown: at most {flown:.5f} over the grid (designed loop: "
-              f"{max(p['spectral_radius'] for p in summary['points']):.5f})")
-        print(f"  {'speed':>7}{'altitude':>10}{'flown':>10}{'designed':>10}{'residual':>10}" + "".join(f"{n:>9}" for n in names))
-        print(f"  {'[m/s]':>7}{'[m AGL]':>10}{'radius':>10}{'radius':>10}")
-        for p in summary["points"]:
-            gains = [p[row][name] for row in ("pitch", "roll") for name in p[row]]
-            print(f"  {p['speed_mps']:>7g}{p['altitude_agl_m']:>10g}{p['flown_spectral_radius']:>10.5f}{p['spectral_radius']:>10.5f}"
-                  f"{p['riccati_residual']:>10.1e}" + "".join(f"{k:>9.4f}" for k in gains))
+    print(json.dumps(summary, indent=2) if args.json else format_schedule(summary, campaign.gnc_inputs.reference))
     if plot:
         plot_gains(summary, plot)
         print(f"wrote {plot}", file=sys.stderr)

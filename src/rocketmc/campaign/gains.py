@@ -308,3 +308,30 @@ def schedule_summary(config: CampaignConfig, schedule: Schedule, inputs: DesignI
                       for name in GuidanceReference._fields if name != "derived"},
         "points": points,
     }
+
+
+def format_schedule(summary: dict, reference: GuidanceReference) -> str:
+    """``schedule_summary``'s result as text: the design's inputs, then one row of main gains per grid point."""
+    mass, window = summary["burnout"], summary["window_estimate"]
+    names = [name for row in ("pitch", "roll") for name in summary["points"][0][row]]
+    flown = max(p["flown_spectral_radius"] for p in summary["points"])
+    designed = max(p["spectral_radius"] for p in summary["points"])
+    lines = [
+        f"{summary['campaign']}: LQI gains ({summary['aero_model']} aerodynamics), {summary['discretisation']} "
+        f"over dt {summary['dt_s']:g} s, Q = diag{tuple(summary['q_weights'])}, R = diag{tuple(summary['r_weights'])}, "
+        f"integrator gains {tuple(summary['integrator_gain'])}",
+        f"  plant at burnout: mass {mass['mass_kg']:.3f} kg, CG x {mass['cg_x_m']:+.3f} m (body, from the "
+        f"reference point), Ixx {mass['ixx_kgm2']:.4g}, Iyy {mass['iyy_kgm2']:.4g} kg·m²; "
+        f"servo {summary['servo_bandwidth_rad_s']:.2f} rad/s",
+        f"  guidance window (nominal flight, point-mass estimate): {window['speed_mps'][0]:.0f} to "
+        f"{window['speed_mps'][1]:.0f} m/s, {window['altitude_agl_m'][0]:.0f} to {window['altitude_agl_m'][1]:.0f} m above the pad",
+        f"  {describe_reference(reference)}",
+        f"  spectral radius of the loop as flown: at most {flown:.5f} over the grid (designed loop: {designed:.5f})",
+        f"  {'speed':>7}{'altitude':>10}{'flown':>10}{'designed':>10}{'residual':>10}" + "".join(f"{n:>9}" for n in names),
+        f"  {'[m/s]':>7}{'[m AGL]':>10}{'radius':>10}{'radius':>10}",
+    ]  # fmt: skip
+    for p in summary["points"]:
+        gains = [p[row][name] for row in ("pitch", "roll") for name in p[row]]
+        lines.append(f"  {p['speed_mps']:>7g}{p['altitude_agl_m']:>10g}{p['flown_spectral_radius']:>10.5f}"
+                     f"{p['spectral_radius']:>10.5f}{p['riccati_residual']:>10.1e}" + "".join(f"{k:>9.4f}" for k in gains))  # fmt: skip
+    return "\n".join(lines)
