@@ -166,6 +166,27 @@ def test_the_dispersions_of_a_section_switched_off_keep_the_pairing(write, campa
         "B disperses gnc.servo.time_constant_s, which A does not; B disperses faults.stuck_canard, which A does not")
 
 
+def test_a_run_is_labelled_with_the_switches_it_was_flown_with(write, campaign, capsys):
+    """A run flown with options that override its campaign file (the controller switched on, the other aerodynamic
+    model, a value set) says so in ``report``, ``compare`` and the plots' labels: its campaign's name alone would
+    call it the file's flights. The file's own run is its name alone."""
+    north, east = _impacts()
+    plain = write("plain.h5", north, east)
+    flown = with_overrides(campaign, controller=True, aero_model="simplified", values={"rocket.dry_mass_kg": 28.0})
+    switched = write("switched.h5", north, east, of=flown)
+    switches = "aero_model simplified, controller on, rocket.dry_mass_kg = 28.0"
+    assert load_run(plain).overrides == {} and load_run(plain).label == "lynx_ballistic"
+    assert load_run(switched).label == f"lynx_ballistic ({switches})"
+    assert main(["compare", plain, switched]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[2:4]]
+    assert [row[:2] for row in rows] == [[plain, "lynx_ballistic"], [switched, "lynx_ballistic"]]
+    assert " ".join(rows[1][2:9]) == f"({switches})"
+    assert main(["report", switched]) == 0
+    assert f"Flown with: {switches} (the campaign file's setting overridden)" in capsys.readouterr().out
+    assert main(["report", plain]) == 0
+    assert "Flown with" not in capsys.readouterr().out
+
+
 def test_flights_failed_in_either_file_are_dropped_from_both(write):
     """A flight not ok in one file leaves both: its far-away (finite) impact, 50 km off, would change
     the area by orders of magnitude if kept. The ratio is that of the areas over the flights ok in

@@ -53,9 +53,8 @@ def test_two_workers_write_the_local_bits(tmp_path, monkeypatch, faulted):
     assert main(["run", faulted, *ARGS, "--out", str(tmp_path / "local.h5"), "--quiet"]) == 0
     want, want_attrs = contents(tmp_path / "local.h5")
     assert_every_fault_recorded(want, N)
-    # A worker restarted after a kill loads the chunk function from JAX's disk cache (seconds)
-    # instead of compiling it again; the first ones compile as usual.
-    monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", str(tmp_path / "jax_cache"))
+    # The workers, and the one restarted after a kill, load the chunk function from the test session's disk
+    # cache of compiled programs (tests/conftest.py), where the local run above left it, instead of compiling it.
     # Starting the cluster sets Dask's pre-spawn variables (OMP_NUM_THREADS=1, ...) in this process for
     # good: restored after this test, so that later tests' subprocesses do not inherit them. The workers
     # run with them: the bits must not depend on BLAS threads (aero.buildup pins its LAPACK solve to one).

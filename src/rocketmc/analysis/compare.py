@@ -28,12 +28,13 @@ class CompareError(RocketmcError, ValueError):
 def dispersion(run: Run, level: float = LEVEL) -> dict:
     """The ``level`` impact ellipse of ``run``'s ok flights (``Ellipse.to_dict()``, metres) with the
     bootstrap intervals of its area [m²] and centre [m] (``bootstrap_intervals``): keys
-    ``campaign_name, seed, n_realizations, n_ok, ellipse, intervals`` and ``navigation_diverged``, the flights of
+    ``campaign_name, label`` (``Run.label``: with the switches flown), ``seed, n_realizations, n_ok, ellipse, intervals`` and ``navigation_diverged``, the flights of
     any status whose navigation estimate diverged (``Run.diverged``; they stay in the ellipse)."""
     north, east = run.ok_impacts()
     _enough(north.size, "ok flight(s) with an impact point")
     return {
         "campaign_name": run.attrs.get("campaign_name", ""),
+        "label": run.label,
         "seed": run.attrs.get("seed"),
         "n_realizations": len(run.outputs),
         "n_ok": int(north.size),
@@ -173,7 +174,7 @@ def format_comparison(comparison: dict) -> str:
     out += _table(
         ["file", "campaign", "ok / N", "area [km^2]", "interval", "N [m]", "interval", "E [m]", "interval"],
         [
-            [r["file"], r["campaign_name"], f"{r['n_ok']} / {r['n_realizations']}",
+            [r["file"], r["label"], f"{r['n_ok']} / {r['n_realizations']}",
              f"{r['ellipse']['area_m2'] / 1e6:.4g}", _interval(r["intervals"]["area_m2"], 1e6),
              f"{r['ellipse']['center_north_m']:.1f}", _interval(r["intervals"]["center_north_m"], fmt="{:.1f}"),
              f"{r['ellipse']['center_east_m']:.1f}", _interval(r["intervals"]["center_east_m"], fmt="{:.1f}")]

@@ -239,7 +239,7 @@ def plot_impacts(
                 fontsize="small", va="bottom", ha="left", bbox={"facecolor": "white", "alpha": 0.8, "linewidth": 0})
         ax.plot(east.mean(), north.mean(), "kX", markersize=9, label="mean impact", zorder=4)
 
-    title = f"{run.attrs.get('campaign_name', '')}: impact points, {n_ok} ok / {n_total}"
+    title = f"{run.label}: impact points, {n_ok} ok / {n_total}"
     missing = int((~run.ok & ~run.has_impact).sum())
     title += f", seed {run.attrs.get('seed')}"
     if n_ok < n_total:
@@ -270,7 +270,7 @@ def plot_histograms(run: Run, folder: str | Path, bins: int = 30) -> dict[Path, 
         edges = np.histogram_bin_edges(np.concatenate([ok, failed]), bins=bins)
         ax.hist([ok, failed], bins=edges, stacked=True, color=["tab:blue", "0.55"],
                 label=[f"ok ({ok.size})", f"failed, landed ({failed.size})"])  # fmt: skip
-        title = f"{run.attrs.get('campaign_name', '')}: {label}, N = {ok.size + failed.size} of {len(x)} flights"
+        title = f"{run.label}: {label}, N = {ok.size + failed.size} of {len(x)} flights"
         if ok.size + failed.size < len(x):
             title += f"\n({len(x) - ok.size - failed.size} without a value: failed in flight or no impact point)"
         ax.set_title(title)
@@ -301,7 +301,7 @@ def plot_comparison(
         north, east = run.ok_impacts()
         _scatter(ax, north, east, color)
         _ellipse(ax, confidence_ellipse(north, east, level), color,
-                 f"{run.attrs.get('campaign_name', '')} ({file}): {100 * level:g} % ellipse")  # fmt: skip
+                 f"{run.label} ({file}): {100 * level:g} % ellipse")  # fmt: skip
     ax.plot(0.0, 0.0, "k^", markersize=10, label="pad", zorder=4)
     _finish(fig, ax, f"Impact points and {100 * level:g} % ellipses of {len(runs)} runs", path)
     return fig

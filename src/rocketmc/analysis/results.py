@@ -77,6 +77,17 @@ class Run:
             return np.zeros(len(self.outputs), dtype=bool)
         return self.outputs[DIVERGED].to_numpy(dtype=float) > 0.5
 
+    @property
+    def overrides(self) -> dict:
+        """What the run switched from its campaign file (``Campaign.overrides``; empty if nothing or unrecorded)."""
+        return json.loads(self.attrs.get("overrides", "{}"))
+
+    @property
+    def label(self) -> str:
+        """The campaign's name and the switches the run was flown with: ``lynx_ballistic_gnc_1s (controller off)``."""
+        name = self.attrs.get("campaign_name", "")
+        return f"{name} ({switches_text(self.overrides)})" if self.overrides else name
+
     def _impacts(self) -> np.ndarray:
         """(2, N) impact points (north, east) [m] of every realization."""
         return self.outputs[["impact_north_m", "impact_east_m"]].to_numpy(dtype=float).T
@@ -86,6 +97,15 @@ class Run:
         (default: ``landed``, the ok ones with finite coordinates)."""
         north, east = self._impacts()[:, self.landed if where is None else where]
         return north, east
+
+
+def switches_text(overrides: dict) -> str:
+    """``Campaign.overrides`` in words: ``controller off, aero_model simplified, rocket.dry_mass_kg = 28``."""
+    def word(name, value):
+        if isinstance(value, bool):
+            return f"{name} {'on' if value else 'off'}"
+        return f"{name} {value}" if "." not in name else f"{name} = {json.dumps(value)}"
+    return ", ".join(word(name, value) for name, value in overrides.items())
 
 
 def _native(value):
@@ -249,7 +269,7 @@ def _metric_stats(values: np.ndarray) -> dict:
 def summarize(run: Run) -> dict:
     """JSON-serialisable summary of a run.
 
-    Keys: ``campaign_name``, ``seed``, ``rocketmc_version``, ``n_realizations``, ``n_ok``,
+    Keys: ``campaign_name``, ``overrides`` (``Run.overrides``), ``seed``, ``rocketmc_version``, ``n_realizations``, ``n_ok``,
     ``status`` (list of code/message/count, every known code and any other code seen), ``failed`` (per
     code seen other than 0: code, message, count, ``landed`` with an impact point and
     ``no_impact_point``; these flights are left out of the metrics and ellipses),
@@ -296,6 +316,7 @@ def summarize(run: Run) -> dict:
     intervals = bootstrap_intervals(north, east, 0.95) if north.size >= MIN_BOOTSTRAP_POINTS else None
     return {
         "campaign_name": run.attrs.get("campaign_name", ""),
+        "overrides": run.overrides,
         "seed": run.attrs.get("seed"),
         "rocketmc_version": run.attrs.get("rocketmc_version", ""),
         "n_realizations": len(run.outputs),
@@ -349,6 +370,8 @@ def format_summary(summary: dict) -> str:
     out = [
         f"Campaign {summary['campaign_name']!r}  (seed {summary['seed']}, "
         f"rocketmc {summary['rocketmc_version']})",
+        *([f"Flown with: {switches_text(summary['overrides'])} (the campaign file's setting overridden)"]
+          if summary["overrides"] else []),  # fmt: skip
         f"Realizations: {summary['n_realizations']} total, {summary['n_ok']} ok",
         *([f"Trajectories kept (rocketmc.analysis.load_trajectories): realizations "
            f"{', '.join(map(str, summary['trajectories']))}"] if summary["trajectories"] else []),  # fmt: skip

@@ -68,7 +68,10 @@ def with_overrides(
     controller on perfect navigation (their faults removed too); navigation: the controller's ("truth", "sensors"
     or "filters"), with sensors to match; values: fields set by dotted path (``{"avionics.gyroscope.truth_only":
     True}``), after the options above, and dispersions by their parameter's path after ``dispersions.``: a table
-    sets one, None removes it. The result file's campaign text stays the file's."""
+    sets one, None removes it. The result file's campaign text stays the file's; the overrides given (N and the seed
+    apart) are added to ``Campaign.overrides``."""
+    switched = {name: value for name, value in (("aero_model", aero_model), ("controller", controller),
+                ("sensors", sensors), ("navigation", navigation)) if value is not None}  # fmt: skip
     if navigation is not None:
         sensors = navigation != "truth"
     data = campaign.config.model_dump()
@@ -100,7 +103,8 @@ def with_overrides(
             data = _set_path(data, path, value)
         except (KeyError, IndexError, TypeError, ValueError):
             raise ConfigError(f"{path}: not a field of this campaign") from None
-    return campaign_from_dict(data, campaign.base_dir, campaign.text)
+    built = campaign_from_dict(data, campaign.base_dir, campaign.text)
+    return dataclasses.replace(built, overrides={**campaign.overrides, **switched, **(values or {})})
 
 
 def _misspelt(errors: list[dict]) -> tuple[dict, str] | None:

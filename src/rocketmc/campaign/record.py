@@ -38,3 +38,6 @@ class Campaign:
     gnc_schedule: Schedule | None = None
     gnc_inputs: DesignInputs | None = None
     weather: Weather | None = None
+    overrides: dict[str, object] = dataclasses.field(default_factory=dict)
+    """What ``with_overrides`` switched from the file (aero_model, controller, sensors, navigation, and values by
+    dotted path; empty for the file as written), kept in the result file's ``overrides`` attribute."""

@@ -96,6 +96,7 @@ class ResultWriter:
         self.n = campaign.config.n_realizations
         self.chunk_size, self.n_chunks = chunking(campaign, chunk_size)
         self.setup = setup(campaign, self.chunk_size)
+        self.overrides = campaign.overrides
         self.fingerprint = fingerprint(self.setup)
         self.manifest = {"format": MANIFEST_FORMAT, "fingerprint": self.fingerprint, "setup": self.setup}
         self.trajectories = trajectories
@@ -288,6 +289,7 @@ class ResultWriter:
                     "rocketmc_version": __version__, "fingerprint": self.fingerprint,
                     "campaign_toml": self.setup["campaign_toml"],  # apart from the rest: an attribute holds ≤ 64 kB
                     "setup": json.dumps({k: v for k, v in self.setup.items() if k != "campaign_toml"}),
+                    "overrides": json.dumps(self.overrides),
                 })  # fmt: skip
                 for group in GROUPS:
                     f.create_group(group)
