@@ -8,12 +8,23 @@ parameter set of the same pytree structure.
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
-import jax
+# The test processes (the two xdist workers, the CLI's subprocesses, the Dask workers) compile the same
+# flight programs many times over; JAX's persistent compilation cache, in a folder of this test session
+# that they all inherit through the environment, compiles each once. A cached program is the same
+# executable, so no result changes. Set before JAX is imported, which reads it then.
+_SESSION_CACHE = "JAX_COMPILATION_CACHE_DIR" not in os.environ
+if _SESSION_CACHE:
+    os.environ["JAX_COMPILATION_CACHE_DIR"] = tempfile.mkdtemp(prefix="rocketmc-tests-jax-cache-")
+
+import jax  # noqa: E402
 import pytest
 
-import rocketmc  # noqa: F401  (enables jax_enable_x64)
+import rocketmc  # noqa: E402, F401  (enables jax_enable_x64)
 
 # Every test runs under strict dtype promotion and with implicit rank promotion refused, so that
 # a mixed-dtype or silently broadcast operation in the library fails the tests instead of passing.
@@ -27,6 +38,11 @@ MOTORS = REPO / "src" / "rocketmc" / "data" / "motors"
 
 def pytest_configure(config):
     assert jax.config.jax_enable_x64, "rocketmc must enable float64 before the tests run"
+
+
+def pytest_unconfigure(config):
+    if _SESSION_CACHE:  # the process that made the folder (the xdist controller, or a serial run) removes it
+        shutil.rmtree(os.environ["JAX_COMPILATION_CACHE_DIR"], ignore_errors=True)
 
 
 @pytest.fixture(scope="session")

@@ -1,8 +1,9 @@
 """The performance ratios (docs/performance.md), measured together in one run on one machine, never absolute times;
 the sensors' cost is printed (``-s``), its bound of 1.3x not met yet (docs/performance.md).
 
-Marked ``performance``: ``make test`` runs them alone after the parallel suite, since another test
-process on the same cores would bias the timings. Each measurement (``rocketmc.bench.measure``) runs in
+Marked ``performance``: ``make test-performance`` runs them alone (CI, after ``make test``), since another test
+process on the same cores would bias the timings; ``make test`` leaves them out, so that it passes on a busy
+laptop. Each measurement (``rocketmc.bench.measure``) runs in
 its own process, compiles its flight functions first, then times them in ``ROUNDS`` interleaved rounds
 (best of each) in process CPU time, so that machine noise hits them alike and other programs on the
 cores do not stretch them: the batch against single flights on every core (``ratios``, about 1.5 minutes

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rocketmc.campaign import parse_campaign, run_chunks, with_overrides
+from rocketmc.campaign import load_campaign, parse_campaign, run_chunks, runner, with_overrides
 
 pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
 
@@ -42,11 +42,13 @@ bias_std = [0.2, 0.2, 0.2, 0.2]
 """
 
 
-@pytest.mark.parametrize("name, sensors", [("lynx_nominal", False), ("lynx_ballistic_ctrl_1s", False),
-                                           ("lynx_ballistic_ctrl_1s", True), ("lynx_ballistic_gnc_1s", False)])  # fmt: skip
-def test_same_bits_for_any_chunk_size(name, sensors):
-    # Chunks of 5 (compiled batches of 16 flights, 8 per core, a padded last chunk) against chunks of
-    # 20 (batches of 32): the same realizations with turbulence, mass, thrust and wind draws, open loop,
+@pytest.mark.parametrize("name, sensors, other_chunk", [("lynx_nominal", False, 12), ("lynx_ballistic_ctrl_1s", False, 12),
+                                                        ("lynx_ballistic_ctrl_1s", True, 12),
+                                                        ("lynx_ballistic_gnc_1s", False, 20)])  # fmt: skip
+def test_same_bits_for_any_chunk_size(name, sensors, other_chunk):
+    # Chunks of 5 (compiled batches of 16 flights, 8 per core, a padded last chunk) against chunks of 12 (the same
+    # compiled batch, other chunk boundaries and padding) or of 20 (batches of 32: another program, once, on the full
+    # GNC; a compilation costs ~25 s): the same realizations with turbulence, mass, thrust and wind draws, open loop,
     # and with the controller on and its servos dispersed, on perfect navigation, on raw sensors (datasheet
     # parts: their turn-on biases drawn per flight, their noise per block) and on the navigation filters (the
     # thesis's sensors, their walks and noise per block).
@@ -57,7 +59,7 @@ def test_same_bits_for_any_chunk_size(name, sensors):
         text = text.replace('navigation = "truth"', 'navigation = "sensors"').replace("[dispersions]", SENSORS + "[dispersions]")
     campaign = with_overrides(parse_campaign(text, path.parent), n_realizations=24)
     a_out, a_in = collect(campaign, 5)
-    b_out, b_in = collect(campaign, 20)
+    b_out, b_in = collect(campaign, other_chunk)
     assert a_out.keys() == b_out.keys() and a_in.keys() == b_in.keys()
     for output in a_out:
         np.testing.assert_array_equal(a_out[output], b_out[output], err_msg=output)  # bit-identical (NaNs equal)
@@ -71,3 +73,20 @@ def test_same_bits_for_any_chunk_size(name, sensors):
         assert len(np.unique(a_out["attitude_error_rms_window_rad"])) == 24
     if sensors:  # the drawn turn-on biases are inputs, one per axis
         assert len(np.unique(a_in["avionics.gyroscope.bias.2"])) == 24 and "avionics.canard_feedback.bias.3" in a_in
+
+
+def test_one_program_for_every_n_and_seed(monkeypatch):
+    """N and the seed are not in the chunk program (the indices and the master key are its arguments): the lowered
+    programs of two runs that differ only in them are the same text, so a process compiles once for both and JAX's
+    disk cache, keyed by that text, serves the next process; another number is another program."""
+    campaign = load_campaign(CAMPAIGNS / "lynx_ballistic.toml")
+    other_n_and_seed = with_overrides(campaign, n_realizations=37, seed=campaign.config.seed + 1)
+    heavier = with_overrides(campaign, values={"rocket.dry_mass_kg": campaign.config.rocket.dry_mass_kg + 1.0})
+    assert runner.lower_chunk(campaign, 16).as_text() == runner.lower_chunk(other_n_and_seed, 16).as_text()
+    assert runner.lower_chunk(campaign, 16).as_text() != runner.lower_chunk(heavier, 16).as_text()
+    compiled = []
+    monkeypatch.setattr(runner, "compile_chunk", lambda c, batch: compiled.append(c) or object())
+    monkeypatch.setattr(runner, "_compiled", runner.OrderedDict())
+    assert runner.compiled_chunk(campaign, 16) is runner.compiled_chunk(other_n_and_seed, 16)
+    assert runner.compiled_chunk(heavier, 16) is not runner.compiled_chunk(campaign, 16)
+    assert compiled == [campaign, heavier]

@@ -29,7 +29,7 @@ from ..sim.outputs import flight_summary
 from ..sim.params import FlightParams
 from ..sim.params import SimSettings
 from .record import Campaign
-from .fingerprint import fingerprint, setup
+from .fingerprint import program_fingerprint
 from .model import flight_params
 from .sampling import realization_key, sample_dispersions, sample_faults
 
@@ -115,8 +115,9 @@ def simulate_queue(params_of: Callable[[jnp.ndarray], FlightParams], queue, sett
     return carry[4], carry[5]
 
 
-def compile_chunk(campaign: Campaign, batch: int) -> Callable:
-    """A compiled function: (master_key, indices (batch,)) -> (summary, status, inputs).
+def lower_chunk(campaign: Campaign, batch: int) -> jax.stages.Lowered:
+    """The chunk function, lowered: (master_key, indices (batch,)) -> (summary, status, inputs). N and the seed are
+    not in it (the indices and the master key are arguments): one program serves every N and seed.
 
     The batch (a ``batch_size``) is split evenly over the local devices (the CPU cores, see
     ``rocketmc.__init__``) with ``shard_map``; each device flies its share on ``GROUP`` lanes and
@@ -132,8 +133,12 @@ def compile_chunk(campaign: Campaign, batch: int) -> Callable:
     mesh = jax.sharding.Mesh(np.array(jax.local_devices()), ("batch",))
     P = jax.sharding.PartitionSpec
     sharded = jax.shard_map(chunk, mesh=mesh, in_specs=(P(), P("batch")), out_specs=P("batch"), check_vma=False)
-    key = jax.random.key(campaign.config.seed)
-    return jax.jit(sharded).lower(key, jnp.zeros(batch, dtype=jnp.uint32)).compile()
+    return jax.jit(sharded).lower(jax.random.key(0), jnp.zeros(batch, dtype=jnp.uint32))
+
+
+def compile_chunk(campaign: Campaign, batch: int) -> Callable:
+    """``lower_chunk(campaign, batch)`` compiled."""
+    return lower_chunk(campaign, batch).compile()
 
 
 COMPILED_KEPT = 4
@@ -145,9 +150,9 @@ _compile_lock = threading.Lock()
 
 
 def compiled_chunk(campaign: Campaign, batch: int) -> Callable:
-    """``compile_chunk(campaign, batch)``, kept per process by the campaign's set-up fingerprint and
-    the batch; one compilation at a time, whatever the process's threads."""
-    key = fingerprint(setup(campaign)), batch
+    """``compile_chunk(campaign, batch)``, kept per process by the program's fingerprint (the set-up without N and
+    the seed) and the batch; one compilation at a time, whatever the process's threads."""
+    key = program_fingerprint(campaign), batch
     with _compile_lock:
         compiled = _compiled.pop(key, None) or compile_chunk(campaign, batch)
         _compiled[key] = compiled  # the most recently used last
