@@ -80,3 +80,17 @@ def test_the_resolution_sees_relative_and_function_level_imports():
     """The parser finds what the tests above need: a relative import at module level and one inside a function."""
     assert "rocketmc.campaign.record" in GRAPH["rocketmc.campaign.model"]  # from .record import Campaign
     assert "rocketmc.campaign" in GRAPH["rocketmc.cli"]  # from .campaign import ..., inside the commands
+
+
+def test_no_private_name_is_imported_from_another_module():
+    """A leading underscore means 'this module's own': another module of the package that needs the name gets it
+    under a public one (``from .plots import save_figure``, not ``_save``)."""
+    private = sorted(
+        (name, f"{node.module}.{alias.name}")
+        for name, path in MODULES.items()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path)))
+        if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith(PACKAGE))
+        for alias in node.names
+        if alias.name.startswith("_") and alias.name != "__version__"
+    )
+    assert not private, private

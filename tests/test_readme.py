@@ -11,7 +11,7 @@ import pytest
 
 from .conftest import REPO
 
-pytestmark = pytest.mark.slow  # flies 100 flights and one recorded flight: ~2 min with their compilation
+pytestmark = pytest.mark.slow  # flies 64 flights and one recorded flight: ~1 min with their compilation
 
 
 def test_the_python_quick_start_runs(tmp_path):

@@ -500,7 +500,7 @@ def build_parser() -> argparse.ArgumentParser:
     _flight_switches(run)
     run.add_argument("--trajectories", metavar="I,J,...",
                      help=f"keep the time series of these realizations (at most {MAX_TRAJECTORIES}), decimated, in the "
-                          "file's /trajectories: each flown after the chunks, bit for bit as fly flies it")  # fmt: skip
+                          "file's /trajectories: each flown after the chunks as fly flies it")  # fmt: skip
     run.add_argument("--trajectory-interval", type=_positive("time in seconds"), default=TRAJECTORY_INTERVAL_S, metavar="S",
                      help="with --trajectories, keep the first sample of each S seconds and the last (default "
                           "%(default)g)")  # fmt: skip
@@ -601,7 +601,8 @@ def build_parser() -> argparse.ArgumentParser:
     fly = commands.add_parser("fly", help="one flight's full time series, summary, figures and KML path")
     fly.add_argument("campaign", help="campaign file (TOML)")
     fly.add_argument("--realization", type=int, metavar="I",
-                     help="fly realization I, bit for bit as in a campaign run (default: the nominal flight)")  # fmt: skip
+                     help="fly realization I as a campaign run flies it: bit for bit, within rounding (~1e-11) with "
+                          "navigation filters (default: the nominal flight)")  # fmt: skip
     fly.add_argument("--out", metavar="FLIGHT.csv|.h5", help="write the time series (CSV or HDF5, with units)")
     fly.add_argument("--plot-dir", metavar="DIR", help="folder for the figures (path, altitude and speed, angles, margin)")
     fly.add_argument("--kml", metavar="PATH", help="write the flight path as KML (Google Earth)")

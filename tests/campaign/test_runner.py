@@ -42,14 +42,13 @@ bias_std = [0.2, 0.2, 0.2, 0.2]
 """
 
 
-@pytest.mark.parametrize("name, sensors, other_chunk", [("lynx_nominal", False, 12), ("lynx_ballistic_ctrl_1s", False, 12),
-                                                        ("lynx_ballistic_ctrl_1s", True, 12),
+@pytest.mark.parametrize("name, sensors, other_chunk", [("lynx_nominal", False, 12), ("lynx_ballistic_ctrl_1s", True, 12),
                                                         ("lynx_ballistic_gnc_1s", False, 20)])  # fmt: skip
 def test_same_bits_for_any_chunk_size(name, sensors, other_chunk):
     # Chunks of 5 (compiled batches of 16 flights, 8 per core, a padded last chunk) against chunks of 12 (the same
     # compiled batch, other chunk boundaries and padding) or of 20 (batches of 32: another program, once, on the full
     # GNC; a compilation costs ~25 s): the same realizations with turbulence, mass, thrust and wind draws, open loop,
-    # and with the controller on and its servos dispersed, on perfect navigation, on raw sensors (datasheet
+    # and with the controller on and its servos dispersed, on raw sensors (datasheet
     # parts: their turn-on biases drawn per flight, their noise per block) and on the navigation filters (the
     # thesis's sensors, their walks and noise per block).
     path = CAMPAIGNS / f"{name}.toml"

@@ -20,7 +20,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from scipy.optimize import nnls
 
-from .plots import _save
+from .plots import save_figure
 
 DOMINANCE = 10.0
 """A term's region: the taus where its Allan variance exceeds the other term's this many times."""
@@ -106,5 +106,5 @@ def plot_allan(series: dict[str, tuple[np.ndarray, np.ndarray]], path: str | Pat
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig

@@ -355,7 +355,7 @@ def plot_budget(summary: dict, path: str | Path | None = None):
     horizontal lines (a log scale when they span more than ``LOG_SCALE_SPAN``); saved to ``path`` if given."""
     from matplotlib.figure import Figure
 
-    from .plots import _save
+    from .plots import save_figure
 
     flown = [r for r in summary["rows"] if r["flown"] and r["ellipse"] is not None]
     bars = [r for r in flown if r["kind"] != "reference"]
@@ -377,5 +377,5 @@ def plot_budget(summary: dict, path: str | Path | None = None):
     if any(r["kind"] == "reference" for r in flown):
         ax.legend(loc="best", fontsize="small")
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig

@@ -15,7 +15,7 @@ import numpy as np
 from ..campaign.schema import FAULT_SECTIONS
 from ..errors import RocketmcError
 from ..ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
-from .results import Run, _table, navigation_warnings
+from .results import Run, text_table, navigation_warnings
 
 LEVEL = 0.95
 """Confidence level of the compared ellipses (the one ``report`` gives bootstrap intervals for)."""
@@ -171,7 +171,7 @@ def format_comparison(comparison: dict) -> str:
     """Compact human-readable table of a :func:`compare` dict."""
     level = f"{100 * comparison['level']:g} %"
     out = [f"Impact {level} ellipses (north/east from pad; interval: 95 % bootstrap interval)"]
-    out += _table(
+    out += text_table(
         ["file", "campaign", "ok / N", "area [km^2]", "interval", "N [m]", "interval", "E [m]", "interval"],
         [
             [r["file"], r["label"], f"{r['n_ok']} / {r['n_realizations']}",
@@ -184,7 +184,7 @@ def format_comparison(comparison: dict) -> str:
     )
     if comparison["ratios"]:
         out += ["", f"{level} ellipse area against {comparison['ratios'][0]['baseline']} (the baseline)"]
-        out += _table(
+        out += text_table(
             ["file", "resampling", "area ratio", "interval", "change [%]", "interval"],
             [
                 [r["file"], f"paired, {r['n_dropped']} dropped (not ok in both)" if r["paired"] else "unpaired",

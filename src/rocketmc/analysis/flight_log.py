@@ -93,7 +93,7 @@ class FlightLog:
     description: str
 
 
-def _read_stream(path: Traversable, period_s: float | None, columns: dict[str, str],
+def read_stream(path: Traversable, period_s: float | None, columns: dict[str, str],
                  optional: tuple[str, ...] = ()) -> pd.DataFrame:  # fmt: skip
     """One CSV stream as ``t_s`` = the first ``t_nominal_s`` + sample × period [s] plus ``columns`` renamed;
     errors name the file. ``period_s`` None: the span of ``t_nominal_s`` / (rows − 1); ``optional``: columns
@@ -128,7 +128,7 @@ def _read_stream(path: Traversable, period_s: float | None, columns: dict[str, s
 def read_flight_log(directory: str | os.PathLike | Traversable, site: Site, description: str) -> FlightLog:
     """The four streams of a log in the Lynx layout (file names and columns as in SOURCE.md)."""
     root = Path(directory) if isinstance(directory, (str, os.PathLike)) else directory
-    streams = {name: _read_stream(root / file, period, columns) for name, (file, period, columns) in _STREAMS.items()}
+    streams = {name: read_stream(root / file, period, columns) for name, (file, period, columns) in _STREAMS.items()}
     return FlightLog(**streams, site=site, description=description)
 
 
@@ -137,7 +137,7 @@ def read_pitot_static(directory: str | os.PathLike | Traversable) -> pd.DataFram
     barometer stream: ``t_s`` = the first sample's time + sample × period [s], the period from ``t_nominal_s``, and
     ``pressure_pa`` [Pa] (its own level: the real log's reads 3050 Pa above the MS5803 on the pad and after landing)."""
     root = Path(directory) if isinstance(directory, (str, os.PathLike)) else directory
-    return _read_stream(root / _STREAMS["pitot"][0], None, {"static_pressure_pa": "pressure_pa"})
+    return read_stream(root / _STREAMS["pitot"][0], None, {"static_pressure_pa": "pressure_pa"})
 
 
 def load_roccaraso_2021() -> FlightLog:

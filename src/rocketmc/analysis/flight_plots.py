@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..files import replacing
 from ..campaign.flights import FlightRecord
 from .flight_record import ascent, events
+from .plots import save_figure
 
 FIGURES = ("path_3d.png", "altitude_speed.png", "angles_of_attack.png", "stability_margin.png")
 _EVENT_COLORS = {"rail exit": "tab:gray", "burnout": "tab:red", "apogee": "tab:green", "impact": "black"}
@@ -19,8 +19,7 @@ _CHUTE_COLORS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive")
 
 def _save(fig: Figure, path: Path) -> None:
     fig.tight_layout()
-    with replacing(path) as partial:
-        fig.savefig(partial, format="png", dpi=150)
+    save_figure(fig, path)
 
 
 def _events(axes, record: FlightRecord, until: float | None = None) -> None:

@@ -21,7 +21,7 @@ from .results import Run
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")
 _FAILED_MARKERS = ("x", "+", "1", "s", "D")
-_RUN_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+RUN_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
                "tab:olive", "tab:cyan")  # fmt: skip
 
 
@@ -279,7 +279,7 @@ def plot_histograms(run: Run, folder: str | Path, bins: int = 30) -> dict[Path, 
         ax.grid(True, alpha=0.4)
         ax.legend(fontsize="small")
         path = Path(folder) / f"{stem}.png"
-        _save(fig, path)
+        save_figure(fig, path)
         figures[path] = fig
     return figures
 
@@ -297,7 +297,7 @@ def plot_comparison(
     """
     fig, ax = _figure(ax)
     for i, (file, run) in enumerate(runs):
-        color = _RUN_COLORS[i % len(_RUN_COLORS)]
+        color = RUN_COLORS[i % len(RUN_COLORS)]
         north, east = run.ok_impacts()
         _scatter(ax, north, east, color)
         _ellipse(ax, confidence_ellipse(north, east, level), color,
@@ -338,10 +338,10 @@ def _finish(fig: Figure, ax: Axes, title: str, path: str | Path | None) -> None:
     for handle in legend.legend_handles:  # faint scatter points stay visible in the legend
         handle.set_alpha(1.0)
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
 
 
-def _save(fig: Figure, path: str | Path) -> None:
+def save_figure(fig: Figure, path: str | Path) -> None:
     """``fig`` at 150 dpi in the format of ``path``'s suffix, written under a temporary name and renamed."""
     with replacing(path) as partial:  # a full disk leaves no half-written figure
         fig.savefig(partial, dpi=150, format=Path(path).suffix.lstrip(".").lower() or "png")
@@ -371,5 +371,5 @@ def plot_gains(summary: dict, path: str | Path | None = None) -> Figure:
     fig.suptitle(f"{summary['campaign']}: LQI gains ({summary['aero_model']} aerodynamics, "
                  f"{summary['discretisation']}, dt {summary['dt_s']:g} s)")  # fmt: skip
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig

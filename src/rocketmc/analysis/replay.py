@@ -42,7 +42,7 @@ from ..gnc.navigation import LIFTOFF_SPECIFIC_FORCE_MPS2, FilterParams, Measurem
 from ..math import Quat, Vec3
 from ..sim.params import Launch
 from .flight_log import pressure_altitude_agl_m
-from .plots import _RUN_COLORS, _save
+from .plots import RUN_COLORS, save_figure
 
 NO_GNSS_ALTITUDE_STD_M = 1e6
 """The standard deviation [m] given to the GNSS's down position, which the log does not hold: read as the filter's
@@ -392,7 +392,7 @@ def plot_navigation(runs: Mapping[str, pd.DataFrame], log: Mapping[str, pd.DataF
     reference = next(iter(heights))
     height = heights[reference]
     end = windows["descent"][1] + 5.0
-    colors = dict(zip(runs, _RUN_COLORS))
+    colors = dict(zip(runs, RUN_COLORS))
     paths = [directory / f"{prefix}{name}" for name in FIGURES]
 
     fig, (ax, ax_error) = _panels(2, f"{label}height above the pad", 3.2)
@@ -405,7 +405,7 @@ def plot_navigation(runs: Mapping[str, pd.DataFrame], log: Mapping[str, pd.DataF
     ax.set_ylabel("height [m]")
     ax_error.set_ylabel(f"estimate − {reference} [m]")
     _decorate((ax, ax_error), windows, end)
-    _save(fig, paths[0])
+    save_figure(fig, paths[0])
 
     gnss = log["gnss"]
     fig, axes = _panels(3, f"{label}velocity (NED)")
@@ -415,7 +415,7 @@ def plot_navigation(runs: Mapping[str, pd.DataFrame], log: Mapping[str, pd.DataF
             ax.plot(nav["t_s"], nav[f"v_{d}_mps"], color=colors[name], linewidth=1.0, label=name)
         ax.set_ylabel(f"v {d} [m/s]")
     _decorate(axes, windows, end)
-    _save(fig, paths[1])
+    save_figure(fig, paths[1])
 
     coast_end = windows["coast"][1] + 2.0
     fig, axes = _panels(3, f"{label}direction of the velocity")
@@ -439,7 +439,7 @@ def plot_navigation(runs: Mapping[str, pd.DataFrame], log: Mapping[str, pd.DataF
     axes[2].set_ylim(-10.0, 10.0)
     axes[2].legend(fontsize="small", loc="best", framealpha=0.9)
     _decorate(axes, windows, coast_end)
-    _save(fig, paths[2])
+    save_figure(fig, paths[2])
 
     fig, axes = _panels(2, f"{label}attitude against the GNSS velocity", 3.2)
     for k, (name, nav) in enumerate(runs.items()):
@@ -452,7 +452,7 @@ def plot_navigation(runs: Mapping[str, pd.DataFrame], log: Mapping[str, pd.DataF
     axes[1].set_ylabel("body x to GNSS velocity [deg]")
     axes[1].set_ylim(0.0, 30.0)
     _decorate(axes, windows, coast_end)
-    _save(fig, paths[3])
+    save_figure(fig, paths[3])
     return paths
 
 

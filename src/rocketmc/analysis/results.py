@@ -347,7 +347,7 @@ def _num(x: float | None) -> str:
     return f"{x:.3f}"
 
 
-def _table(header: list[str], rows: list[list[str]], align: str) -> list[str]:
+def text_table(header: list[str], rows: list[list[str]], align: str) -> list[str]:
     """Aligned text table; ``align`` holds one "l" (left) or "r" (right) per column."""
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
 
@@ -378,7 +378,7 @@ def format_summary(summary: dict) -> str:
         *(f"Warning: {line}" for line in summary["warnings"]),
         "",
         "Status",
-        *_table(
+        *text_table(
             ["code", "count", "message"],
             [[str(s["code"]), str(s["count"]), s["message"]] for s in summary["status"]],
             align="rrl",
@@ -387,7 +387,7 @@ def format_summary(summary: dict) -> str:
     ]
     if summary["failed"]:
         out += ["Failed realizations (not in the metrics or ellipses; their impact points are drawn apart)"]
-        out += _table(
+        out += text_table(
             ["code", "count", "landed", "no impact point", "message"],
             [[str(s["code"]), str(s["count"]), str(s["landed"]), str(s["no_impact_point"]), s["message"]]
              for s in summary["failed"]],
@@ -396,7 +396,7 @@ def format_summary(summary: dict) -> str:
         out.append("")
     out += ["Metrics (ok realizations)"]
     stat_keys = ["mean", "std", "min", *_PERCENTILES, "max"]
-    out += _table(
+    out += text_table(
         ["metric", "unit", "n", *stat_keys],
         [
             [name, m["unit"], str(m["n"]), *(_num(m[k]) for k in stat_keys)]
@@ -406,7 +406,7 @@ def format_summary(summary: dict) -> str:
     )
     out += ["", "Impact ellipses (north/east from pad)"]
     if summary["impact_ellipses"]:
-        out += _table(
+        out += text_table(
             ["level", "N [m]", "E [m]", "a [m]", "b [m]", "az [deg]", "area [km^2]", "area [m^2]", "inside"],
             [
                 [
@@ -435,7 +435,7 @@ def format_summary(summary: dict) -> str:
         out.append("  not available: fewer than 3 ok impact points")
     if summary["faults"]:
         out += ["", "Faults (/inputs/faults.*): the 95 % ellipse of the ok flights with and without the faulted ones"]
-        out += _table(["fault", "flights", "not ok", "area with [km^2]", "without [km^2]", "change", "centre with N, E [m]",
+        out += text_table(["fault", "flights", "not ok", "area with [km^2]", "without [km^2]", "change", "centre with N, E [m]",
                        "without N, E [m]"], [_fault_cells(f) for f in summary["faults"]], align="lrrrrrrr")  # fmt: skip
     return "\n".join(out)
 

@@ -39,8 +39,8 @@ from matplotlib.figure import Figure
 from scipy.stats import median_abs_deviation
 
 from ..files import replacing
-from .flight_log import _read_stream
-from .plots import _save
+from .flight_log import read_stream
+from .plots import save_figure
 
 LOG_FILES = {
     "imu": ("imu_bmx160_50hz.csv", ("sample", "t_nominal_s", "acc_x_mps2", "acc_y_mps2", "acc_z_mps2",
@@ -84,7 +84,7 @@ def read_sensor_log(directory: str | os.PathLike | Traversable) -> dict[str, pd.
     ``t_s`` = the first sample's time + sample × period [s] and the value columns named as in the CSV headers
     (a simulated log's ``num_sats`` is NaN: not modelled)."""
     root = Path(directory) if isinstance(directory, (str, os.PathLike)) else directory
-    return {name: _read_stream(root / file, None, {c: c for c in header[2:]}, optional=("num_sats",))
+    return {name: read_stream(root / file, None, {c: c for c in header[2:]}, optional=("num_sats",))
             for name, (file, header) in LOG_FILES.items()}  # fmt: skip
 
 
@@ -152,5 +152,5 @@ def plot_log_comparison(simulated: dict[str, pd.DataFrame], real: dict[str, pd.D
     axes[0].legend(fontsize="small")
     fig.suptitle("Sensor logs: simulated and real")
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig
