@@ -10,11 +10,12 @@ import pytest
 from rocketmc.aero import AirData
 from rocketmc.aero.model import linear_derivatives, simplify
 from rocketmc.aero.stability import centre_of_pressure_at
-from rocketmc.analysis.flight_record import energy_balance
+from rocketmc.analysis.flight_record import energy_balance, events, format_record
 from rocketmc.campaign import load_campaign, run_chunks, with_overrides
 from rocketmc.campaign.flights import flight_record
 from rocketmc.campaign.model import nominal_params
 from rocketmc.env import G0
+from rocketmc.sim.outputs import DEPLOY_TIME_SUFFIX
 
 pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
 
@@ -40,6 +41,19 @@ def test_realization_is_the_campaign_row(campaign, record):
         np.testing.assert_array_equal(value, chunk.outputs[name][REALIZATION], err_msg=name)
     assert record.status == chunk.outputs["status"][REALIZATION] == 0
     assert len(np.unique(chunk.outputs["apogee_agl_m"])) == N  # the realizations do differ
+
+
+def test_the_summary_and_the_events_name_each_parachute(campaign, record):
+    """The printed summary and the event list (the figures' and the KML's marks) carry the drogue's and the main's
+    deployment at the times the flight summary holds, between apogee and impact."""
+    printed, marks = format_record(record), dict(events(record))
+    assert [name for name, _ in events(record)] == ["rail exit", "burnout", "apogee", "drogue deployed",
+                                                    "main deployed", "impact"]  # fmt: skip
+    for chute in campaign.config.rocket.parachutes:
+        deployed_s = record.summary[chute.name + DEPLOY_TIME_SUFFIX]
+        assert marks[f"{chute.name} deployed"] == deployed_s
+        assert f"{chute.name + ' deploys':<14}{deployed_s:8.3f} s" in printed
+    assert "descent rate under the main" in printed
 
 
 def test_coast_energy_balance(record):

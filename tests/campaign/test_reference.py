@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import tomllib
-
 from rocketmc.campaign.limits import fixed_reason
 from rocketmc.campaign.reference import INDEX, reference, rows, unit
 

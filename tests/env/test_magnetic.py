@@ -33,7 +33,7 @@ import ppigrf
 from ppigrf.ppigrf import shc_fn_igrf13
 
 from rocketmc.env.magnetic import (
-    GRADIENT_STEP_M, IGRF14_TABLE, DipoleCoefficients, _ned_axes, dipole_field_ned, first_order_field, igrf_dipole,
+    IGRF14_TABLE, DipoleCoefficients, _ned_axes, dipole_field_ned, first_order_field, igrf_dipole,
     igrf_site_field_gradient, igrf_validity, site_field_gradient, site_field_ned,
 )
 from rocketmc.math import Vec3

@@ -16,7 +16,7 @@ from ..campaign.flights import FlightRecord
 from ..campaign.store import write_columns
 from ..env.site import latitude_longitude_deg
 from ..files import replacing, replacing_hdf5
-from ..sim.outputs import metric
+from ..sim.outputs import DEPLOY_TIME_SUFFIX, metric
 from ..sim.state import Status
 from .export import KML_NAMESPACE
 

@@ -25,7 +25,6 @@ import os
 import time
 import uuid
 from collections import deque
-from collections.abc import Callable
 from concurrent.futures import CancelledError
 from contextlib import contextmanager
 
@@ -33,7 +32,6 @@ import jax
 from distributed import Client, KilledWorker, LocalCluster
 from distributed.comm import CommClosedError
 
-from ..runtime import __version__
 from ..errors import RocketmcError
 from .record import Campaign
 from .fingerprint import differences, setup
