@@ -33,6 +33,11 @@ jax.config.update("jax_numpy_rank_promotion", "raise")
 
 REPO = Path(__file__).resolve().parents[1]
 CAMPAIGNS = REPO / "campaigns"
+
+
+def movable(text: str) -> str:
+    """A shipped campaign's text that loads from any folder: the campaign it extends named by its full path."""
+    return text.replace('extends = "', f'extends = "{CAMPAIGNS}/')
 MOTORS = REPO / "src" / "rocketmc" / "data" / "motors"
 
 

@@ -8,7 +8,7 @@ import tomllib
 import pytest
 
 from rocketmc.aero.buildup import MAX_SUBSONIC_MACH
-from rocketmc.campaign import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict, read_campaign_tables
 from rocketmc.campaign.checks import aero_validity_warnings, nominal_static_margins, stability_warnings
 
 from ..conftest import CAMPAIGNS
@@ -86,7 +86,7 @@ def test_filters_on_uncalibrated_parts_are_warned(avionics, navigation, warned):
     calibrated parts (2 µT, 0.2 deg/s), the thesis's and raw-sensor navigation: none."""
     from rocketmc.campaign.checks import calibration_warnings
 
-    raw = tomllib.loads((CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text())
+    raw = read_campaign_tables(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")
     raw = {**raw, "gnc": {**raw["gnc"], "navigation": navigation}, "avionics": avionics, "dispersions": {}}
     lines = calibration_warnings(campaign_from_dict(raw, CAMPAIGNS))
     assert [line.split("uncalibrated ")[1].split(" ")[0] for line in lines] == warned, lines

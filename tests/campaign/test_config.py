@@ -89,19 +89,26 @@ def _over(base, override):
     return merged
 
 
+def _written(path):
+    """A campaign file's tables over those of the campaign it extends (beside it), read with tomllib."""
+    data = tomllib.loads(path.read_text())
+    base = data.pop("extends", None)
+    return data if base is None else _over(_written(path.parent / base), data)
+
+
 def _number(x):
     return isinstance(x, int | float) and not isinstance(x, bool)
 
 
 @pytest.mark.parametrize("path", sorted(CAMPAIGNS.glob("*.toml")), ids=lambda p: p.name)
 def test_shipped_campaigns_load(path):
-    """What the loader holds is what the campaign file and its preset say, read here with tomllib:
+    """What the loader holds is what the campaign file, the campaigns it extends and its preset say, read here with tomllib:
     every number of the rocket (the preset under the file's overrides, lists replaced whole),
     launch, environment and gnc tables is its nominal value, and the only other nominal values are
     the schema's defaults listed in DEFAULTS (and GncConfig's, with a [gnc] section); name, N, seed,
     site, simulation and the dispersions are the file's; a RASP thrust curve is the file's points
     after the implicit (0, 0)."""
-    data = tomllib.loads(path.read_text())
+    data = _written(path)
     campaign = load_campaign(path)
     config = campaign.config
     rocket = dict(data["rocket"])
@@ -154,6 +161,52 @@ def test_preset_and_override():
     campaign = parse_campaign(edited('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = 20.0'))
     assert campaign.nominal["rocket.dry_mass_kg"] == 20.0
     assert campaign.nominal["rocket.aero.linear.cn_alpha"] == pytest.approx(24.0744)  # untouched preset value
+
+
+def test_a_campaign_extends_another(tmp_path):
+    """A variant of a few lines: its tables laid over the base's key by key, through a chain of two, is the base
+    edited by hand; an array of tables (the wind layers) replaces the base's whole, not layer by layer."""
+    (tmp_path / "base.toml").write_text(NOMINAL)
+    (tmp_path / "heavy.toml").write_text('extends = "base.toml"\nname = "heavy"\n[rocket]\ndry_mass_kg = 20.0\n')
+    (tmp_path / "steep.toml").write_text('extends = "heavy.toml"\nname = "steep"\n[launch]\nelevation_deg = 85.0\n')
+    by_hand = edited('name = "lynx_nominal"', 'name = "steep"').replace(
+        'preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = 20.0').replace("elevation_deg = 84.0", "elevation_deg = 85.0")
+    assert load_campaign(tmp_path / "steep.toml").config == parse_campaign(by_hand).config
+    layers = "".join(f"[[environment.wind.layers]]\nspeed_mps = {v}\nfrom_deg = 90.0\n{thickness}\n"
+                     for v, thickness in ((1.0, "thickness_m = 100.0"), (2.0, "thickness_m = 50.0"), (3.0, "")))
+    (tmp_path / "east.toml").write_text(f'extends = "base.toml"\n{layers}')
+    east = load_campaign(tmp_path / "east.toml").config.environment.wind.layers
+    assert [(layer.speed_mps, layer.from_deg, layer.thickness_m) for layer in east] == [
+        (1.0, 90.0, 100.0), (2.0, 90.0, 50.0), (3.0, 90.0, None)]  # fmt: skip
+    (tmp_path / "east.toml").write_text('extends = "base.toml"\n[[environment.wind.layers]]\nspeed_mps = 1.0\n'
+                                        "from_deg = 90.0\n[[environment.wind.layers]]\nspeed_mps = 2.0\nfrom_deg = 90.0\n")
+    with pytest.raises(ConfigError, match="layers.0.thickness_m is required"):  # not the base's first layer's 275 m
+        load_campaign(tmp_path / "east.toml")
+
+
+@pytest.mark.parametrize(("files", "words"), [
+    ({"a.toml": 'extends = "b.toml"', "b.toml": 'extends = "a.toml"'}, "extends: 'b.toml' → 'a.toml' → 'b.toml' is a circle"),
+    ({"a.toml": 'extends = "nowhere.toml"'}, "extends: file not found: 'nowhere.toml'"),
+    ({"a.toml": "extends = 3"}, "extends: expected a campaign file name"),
+    ({"a.toml": 'extends = "b.toml"', "b.toml": "name = "}, "extends: 'b.toml' is not valid TOML"),
+])  # fmt: skip
+def test_a_bad_extends_is_one_line(tmp_path, files, words):
+    for name, text in files.items():
+        (tmp_path / name).write_text(text + "\n")
+    with pytest.raises(ConfigError, match=f"^{re.escape(words)}"):
+        load_campaign(tmp_path / "a.toml")
+
+
+def test_a_rocket_from_a_file_of_the_users(tmp_path):
+    """``rocket.preset = "my_rocket.toml"``: a [rocket] table's keys in a file beside the campaign, overridable as a
+    built-in preset's; the Lynx's preset copied there gives the built-in preset's campaign."""
+    (tmp_path / "my_rocket.toml").write_text((ROCKETS / "lynx.toml").read_text())
+    (tmp_path / "c.toml").write_text(edited('preset = "lynx"', 'preset = "my_rocket.toml"\ndry_mass_kg = 20.0'))
+    mine = load_campaign(tmp_path / "c.toml")
+    assert mine.config == parse_campaign(edited('preset = "lynx"', 'preset = "lynx"\ndry_mass_kg = 20.0')).config
+    (tmp_path / "c.toml").write_text(edited('preset = "lynx"', 'preset = "their_rocket.toml"'))
+    with pytest.raises(ConfigError, match="^rocket.preset: file not found: 'their_rocket.toml'"):
+        load_campaign(tmp_path / "c.toml")
 
 
 @pytest.mark.parametrize(

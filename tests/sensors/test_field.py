@@ -16,7 +16,7 @@ import numpy as np
 import ppigrf
 import pytest
 
-from rocketmc.campaign import ConfigError, campaign_from_dict
+from rocketmc.campaign import ConfigError, campaign_from_dict, read_campaign_tables
 from rocketmc.campaign.loader import sensor_spreads
 from rocketmc.campaign.model import filter_params
 from rocketmc.campaign.runner import realization_params, sim_settings
@@ -28,7 +28,7 @@ from rocketmc.sim.flight import fly
 from ..conftest import CAMPAIGNS
 
 NOMINAL = tomllib.loads((CAMPAIGNS / "lynx_nominal.toml").read_text())
-GNC = tomllib.loads((CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text())
+GNC = read_campaign_tables(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")
 DAY = datetime.date(2021, 9, 13)
 ANOMALY_NT = [400.0, -250.0, 150.0]
 

@@ -11,14 +11,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.campaign import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict, read_campaign_tables
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import sim_settings
 from rocketmc.gnc.guidance import reference_direction
@@ -35,7 +34,7 @@ N_PERIODS = 650  # 13 s at 0.02 s: ignition at 0.5 s, the window ends 10 s after
 def headwind(name: str):
     """The campaign ``name`` with a constant 10 m/s wind from the launch azimuth, nothing dispersed."""
     path = CAMPAIGNS / f"{name}.toml"
-    raw = tomllib.loads(path.read_text())
+    raw = read_campaign_tables(path)
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": 10.0, "from_deg": raw["launch"]["azimuth_deg"]}}
     raw["dispersions"] = {}
     return campaign_from_dict(raw, path.parent)

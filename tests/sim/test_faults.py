@@ -11,14 +11,13 @@ from __future__ import annotations
 
 import functools
 import math
-import tomllib
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.campaign import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict, read_campaign_tables
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.dynamics.servo import ServoParams, ServoState, deflection_at
 from rocketmc.sim.faults import Faults, SlowCanard, StuckCanard, faulty_servos
@@ -41,7 +40,7 @@ CLEAN = {"noise_std": 0.0, "bias": [0.0, 0.0, 0.0], "bias_walk": 0.0, "lsb": 0.0
 
 def campaign(faults: dict):
     path = CAMPAIGNS / "lynx_ballistic_ctrl_1s.toml"
-    raw = tomllib.loads(path.read_text())
+    raw = read_campaign_tables(path)
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": 5.0, "from_deg": 0.0}}
     raw["dispersions"] = {}
     raw["avionics"] = {"part": "thesis", "gyroscope": CLEAN, "accelerometer": CLEAN, "magnetometer": {"truth_only": True}}

@@ -13,14 +13,13 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import tomllib
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from rocketmc.campaign import campaign_from_dict
+from rocketmc.campaign import campaign_from_dict, read_campaign_tables
 from rocketmc.campaign.model import nominal_params
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.gnc.attitude_filter import attitude_error_b
@@ -54,7 +53,7 @@ def headwind(errors: bool = True, pad_samples: int | None = None, magnetometer: 
     magnetometer: fields of its [avionics.magnetometer] table; sensors: [avionics] tables of fields over the thesis
     part's."""
     path = CAMPAIGNS / "lynx_ballistic_gnc_1s.toml"
-    raw = tomllib.loads(path.read_text())
+    raw = read_campaign_tables(path)
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": 10.0, "from_deg": raw["launch"]["azimuth_deg"]},
                           "magnetic_field": raw["environment"]["magnetic_field"]}  # the thesis's dipole, as flown
     raw["dispersions"] = {}
@@ -203,7 +202,7 @@ def test_navigation_starts_from_the_nominal_rail_not_the_drawn_one():
     """A campaign dispersing the rail's elevation (σ 2°) and azimuth (σ 10°): a realization's rail is not the
     nominal, but its filters (and the raw sensors' dead reckoning) start from the nominal rail's attitude and the
     nominal rocket's CG on it, which is all the avionics know."""
-    raw = tomllib.loads((CAMPAIGNS / "lynx_ballistic_gnc_1s.toml").read_text())
+    raw = read_campaign_tables(CAMPAIGNS / "lynx_ballistic_gnc_1s.toml")
     raw["dispersions"] = {"launch.elevation_deg": {"dist": "normal", "std": 2.0, "high": 89.0},
                           "launch.azimuth_deg": {"dist": "normal", "std": 10.0}}  # fmt: skip
     nominal = nominal_params(campaign_from_dict(raw, CAMPAIGNS))
@@ -269,7 +268,7 @@ def test_the_main_deploys_at_the_estimated_height():
     fix at that tick), interpolated in the step as the true triggers are (to 1e-6 m: rounding); the drogue at the
     sensed apogee, after the true one. The recorded apogee is the true one."""
     path = CAMPAIGNS / "lynx_nominal_ctrl_1s_sensors.toml"
-    raw = tomllib.loads(path.read_text())
+    raw = read_campaign_tables(path)
     raw["environment"] = {"wind": {"model": "constant", "speed_mps": 0.0, "from_deg": 0.0}}
     raw["dispersions"] = {}
     raw["avionics"]["gnss"] = {"position_noise_m": [0.0] * 3, "velocity_noise_mps": [0.0] * 3,

@@ -24,12 +24,14 @@ _KML_MARKER_COLORS = {"ok": "ffb4771f", "failed": "ff000000"}  # the same in aab
 
 
 def site_of(run: Run) -> tuple[str, float, float]:
-    """(name, latitude [deg], longitude [deg]) of the run's launch site, from its campaign text."""
+    """(name, latitude [deg], longitude [deg]) of the run's launch site, from its validated campaign (the set-up's
+    config: a campaign that extends another may not name its site in its own text), else from its campaign text."""
     try:
-        site = tomllib.loads(run.attrs["campaign_toml"])["site"]
-        return site.get("name", ""), float(site["latitude_deg"]), float(site["longitude_deg"])
-    except (KeyError, tomllib.TOMLDecodeError, TypeError, ValueError):
-        raise ResultFileError("the result file's campaign_toml attribute has no [site] latitude_deg/longitude_deg") from None
+        config = json.loads(run.attrs["setup"])["config"] if "setup" in run.attrs else tomllib.loads(run.attrs["campaign_toml"])
+        site = config["site"]
+        return site.get("name") or "", float(site["latitude_deg"]), float(site["longitude_deg"])
+    except (KeyError, json.JSONDecodeError, tomllib.TOMLDecodeError, TypeError, ValueError):
+        raise ResultFileError("the result file's campaign has no [site] latitude_deg/longitude_deg") from None
 
 
 def map_features(run: Run, levels=SUMMARY_LEVELS) -> dict:

@@ -4,6 +4,7 @@ from .errors import ConfigError as ConfigError
 from .loader import campaign_from_dict as campaign_from_dict
 from .loader import load_campaign as load_campaign
 from .loader import parse_campaign as parse_campaign
+from .loader import read_campaign_tables as read_campaign_tables
 from .loader import with_overrides as with_overrides
 from .model import flight_params as flight_params
 from .model import nominal_params as nominal_params

@@ -154,13 +154,43 @@ def _deep_merge(base: dict, override: dict) -> dict:
     return merged
 
 
-def preset_rocket(name: str) -> dict:
-    """The rocket table of a built-in preset (``data/rockets/<name>.toml``)."""
+def preset_rocket(name: str, base_dir: Path = Path(".")) -> dict:
+    """The rocket table of a preset: a built-in one by name (``data/rockets/<name>.toml``), or a file of the user's
+    (a name ending in ``.toml``, beside the campaign) holding the keys of a ``[rocket]`` table."""
+    if name.endswith(".toml"):
+        return _toml_file(name, base_dir, "rockets", "rocket.preset")[1]
     folder = resources.files("rocketmc") / "data" / "rockets"
     available = sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml"))
-    if name not in available:  # a name, not a path
-        raise ConfigError(f"rocket.preset: unknown preset {shown(name)} (available: {', '.join(available)})")
+    if name not in available:
+        raise ConfigError(f"rocket.preset: unknown preset {shown(name)} (available: {', '.join(available)}, "
+                          "or a file name ending in .toml)")  # fmt: skip
     return tomllib.loads((folder / f"{name}.toml").read_text())
+
+
+def _toml_file(name: str, base_dir: Path, folder: str, field: str) -> tuple[Path, dict]:
+    """The TOML file ``name`` (beside the campaign, else built in ``data/<folder>``) and its tables."""
+    path = _resolve_data_file(name, base_dir, folder, field)
+    try:
+        return path, tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise ConfigError(f"{field}: {shown(name)} is not valid TOML ({e})") from None
+
+
+def _extended(raw: dict, base_dir: Path, seen: tuple[Path, ...] = ()) -> dict:
+    """The campaign's tables laid over those of the campaign it ``extends`` (a file beside it, else a built-in
+    campaign), which may itself extend another (named from its own folder): tables merge key by key, every other
+    value (an array of tables too) replaces the base's. The data files they name are looked up beside the campaign
+    loaded."""
+    if "extends" not in raw:
+        return raw
+    name = raw.pop("extends")
+    if not isinstance(name, str):
+        raise ConfigError(f"extends: expected a campaign file name (got {shown(name)})")
+    path, base = _toml_file(name, base_dir, "campaigns", "extends")
+    chain = (*seen, path.resolve())
+    if path.resolve() in seen:
+        raise ConfigError(f"extends: {' → '.join(shown(p.name) for p in chain)} is a circle")
+    return _deep_merge(_extended(base, path.parent, chain), raw)
 
 
 def _resolve_data_file(name: str, base_dir: Path, folder: str, field: str) -> Path:
@@ -264,6 +294,13 @@ def _check_spread_draws(data: dict, path: str, d: Dispersion, nominal_value: flo
                               "path (low, high)") from None  # fmt: skip
 
 
+def read_campaign_tables(path: str | Path) -> dict:
+    """The tables of a campaign file with the campaigns it ``extends`` laid under them: what to edit and hand to
+    ``campaign_from_dict(tables, path.parent)``."""
+    path = Path(path)
+    return _extended(_toml_file(path.name, path.parent, "campaigns", "campaign file")[1], path.parent, (path.resolve(),))
+
+
 def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
     """Validate a campaign from its TOML text; relative files are looked up from ``base_dir``."""
     try:
@@ -276,13 +313,13 @@ def parse_campaign(text: str, base_dir: Path = Path(".")) -> Campaign:
 def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") -> Campaign:
     """Validate a campaign from the tables of a campaign file (e.g. one read with ``tomllib`` and
     edited); ``text`` is what result files record as the campaign's source."""
-    raw = copy.deepcopy(raw)
+    raw = _extended(copy.deepcopy(raw), base_dir)
     rocket = raw.get("rocket")
     if isinstance(rocket, dict) and "preset" in rocket:
         overrides = {k: v for k, v in rocket.items() if k != "preset"}
         if not isinstance(rocket["preset"], str):
             raise ConfigError(f"rocket.preset: expected a string (got {rocket['preset']!r})")
-        raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"]), overrides)
+        raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"], base_dir), overrides)
     config = _validate(raw)
     _check_geometry(config.rocket)
 
