@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
+from .propulsion import cumulative_impulse, read_thrust_curve
 
 LIBRARY_FOLDER = "library"
 """The library's folder inside the package's ``data/motors`` (a campaign's ``thrust_curve`` may name a file there as
