@@ -396,3 +396,21 @@ def test_report_outside_polygon(small_run, tmp_path, capsys):
     assert main(["report", str(small_run), "--outside-polygon", str(bad), "--csv", str(csv)]) == 2
     out, err = capsys.readouterr()
     assert out == "" and len(err.splitlines()) == 1 and str(bad) in err and "lon_deg" in err and not csv.exists()
+
+
+def test_motors_lists_the_library(capsys):
+    """The table's header and one line per motor; a search keeps those whose name, designation or maker holds it."""
+    assert main(["motors"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split()[:4] == ["motor", "designation", "maker", "diameter"] and len(lines) == 1 + 61
+    assert main(["motors", "L-1350"]) == 0
+    (header, row) = capsys.readouterr().out.splitlines()
+    assert row.split() == ["Cesaroni_4263L1350-P", "4263-L1350-CS-P", "CTI", "75", "486", "4280", "L", "1350", "3.17",
+                           "2.025", "3.571"]  # fmt: skip
+
+
+def test_motors_without_a_match_exits_2(capsys):
+    assert main(["motors", "hybrid"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == "rocketmc: error: no motor of the library matches 'hybrid' (`rocketmc motors` lists them all)\n"

@@ -2,7 +2,7 @@
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
 a campaign, ``sensors simulate``: one realization's sensor log, ``navigate``: the navigation filters replayed on
 a sensor log, ``fly``: one flight's time series, ``validate`` the simulation against a real flight, ``bench`` this
-machine, ``budget``: the GNC error budget of a closed-loop campaign."""
+machine, ``budget``: the GNC error budget of a closed-loop campaign, ``motors``: the built-in motor library."""
 
 from __future__ import annotations
 
@@ -655,7 +655,26 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--chunk-size", type=COUNT, metavar="C",
                        help="realizations per compiled chunk (default: the campaign's)")  # fmt: skip
     bench.add_argument("--json", action="store_true", help="print the results as JSON instead of a table")
+    motors = commands.add_parser(
+        "motors", help="list the built-in motor library (what rocket.motor.designation names)",
+        description="The built-in library of commercial motors (RASP .eng certification curves): per motor its "
+        "file's name, designation, manufacturer, diameter and length, the curve's total impulse, NAR class, average "
+        "thrust over its burn time (thrust at or above 5 % of its maximum), and the propellant and total masses.",
+    )  # fmt: skip
+    motors.add_argument("search", nargs="?", help="only the motors whose name, designation or manufacturer contains "
+                        "this (case and punctuation ignored: l1350, cesaroni, K-400)")  # fmt: skip
     return parser
+
+
+def _motors(args) -> int:
+    from .analysis.motors import motor_table
+    from .dynamics.motor_library import matching_motors
+
+    entries = matching_motors(args.search)
+    if not entries:
+        raise RocketmcError(f"no motor of the library matches {args.search!r} (`rocketmc motors` lists them all)")
+    print(motor_table(entries))
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -664,7 +683,8 @@ def main(argv: list[str] | None = None) -> int:
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
-               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget}  # fmt: skip
+               "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget,
+               "motors": _motors}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

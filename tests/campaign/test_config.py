@@ -1,5 +1,6 @@
 """Campaign validation: each kind of bad input is one line naming the field."""
 
+import copy
 import re
 import tomllib
 from pathlib import Path
@@ -8,7 +9,10 @@ import jax
 import numpy as np
 import pytest
 
-from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, parse_campaign
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, parse_campaign, with_overrides
+from rocketmc.campaign.checks import motor_warnings
+from rocketmc.campaign.fingerprint import setup
+from rocketmc.dynamics.motor_library import casing_inertia_kgm2, estimated_grain, find_motor
 from rocketmc.campaign.schema import GncConfig
 from rocketmc.campaign.model import nominal_params
 
@@ -346,3 +350,99 @@ def test_turbulence_section():
     assert float(turbulence.w20_mps) == pytest.approx(30 * 1852 / 3600, rel=1e-14)  # moderate: 30 kt
     given = with_wind({}, turbulence={"severity": 2.0, "w20_mps": 4.0})
     assert float(nominal_params(campaign_from_dict(given)).environment.turbulence.w20_mps) == 4.0
+
+
+CUSTOM = tomllib.loads((CAMPAIGNS / "custom_rocket.toml").read_text())
+"""A rocket written out (no preset), its motor given by thrust_curve, propellant, grain and casing."""
+LIBRARY_DEFAULTS = ("thrust_curve", "propellant_mass_kg", "grain_outer_diameter_m", "grain_inner_diameter_m",
+                    "grain_length_m", "dry_mass_kg", "dry_inertia_kgm2")  # fmt: skip
+
+
+def with_motor(**motor) -> dict:
+    """``custom_rocket`` with its motor's curve, propellant, grain and casing replaced by ``motor``."""
+    data = copy.deepcopy(CUSTOM)
+    kept = {k: v for k, v in data["rocket"]["motor"].items() if k not in LIBRARY_DEFAULTS}
+    data["rocket"]["motor"] = {**kept, **motor}
+    return data
+
+
+def test_a_designation_is_its_library_file_with_the_defaults_written_out():
+    """``designation = "L1350"`` flies what the library's file flies with the header's propellant, the estimated
+    grain and the casing (total − propellant, a thin tube's inertia) written out: the same nominal numbers and the
+    same thrust arrays, bit for bit, and the same file digest, under the field that names it."""
+    named = campaign_from_dict(with_motor(designation="L1350"), CAMPAIGNS)
+    entry = find_motor("L1350")
+    outer, core, length = estimated_grain(entry)
+    dry = entry.total_mass_kg - entry.propellant_mass_kg
+    written = campaign_from_dict(with_motor(
+        thrust_curve="library/Cesaroni_4263L1350-P.eng", propellant_mass_kg=entry.propellant_mass_kg,
+        grain_outer_diameter_m=outer, grain_inner_diameter_m=core, grain_length_m=length, dry_mass_kg=dry,
+        dry_inertia_kgm2=list(casing_inertia_kgm2(entry, dry))), CAMPAIGNS)  # fmt: skip
+    assert named.thrust_time_s.tobytes() == written.thrust_time_s.tobytes()
+    assert named.thrust_n.tobytes() == written.thrust_n.tobytes()
+    assert named.nominal == written.nominal
+    assert named.files == {"rocket.motor.designation": written.files["rocket.motor.thrust_curve"]}
+    assert named.motor == written.motor == entry
+    assert named.nominal["rocket.motor.dry_mass_kg"] == dry and named.nominal["rocket.dry_mass_kg"] == 14.426
+    # loaded again from its own configuration (what with_overrides and the dispersion checks validate): the same
+    again = with_overrides(named, n_realizations=3)
+    assert again.nominal == named.nominal and again.config.rocket.motor == named.config.rocket.motor
+
+
+def test_values_given_beside_a_designation_win():
+    """The file's own propellant mass, grain and casing are kept; the casing's inertia follows the dry mass given
+    (0: the rocket's dry mass includes the casing, so no second casing)."""
+    campaign = campaign_from_dict(with_motor(designation="L1350", propellant_mass_kg=1.95, grain_length_m=0.4,
+                                             dry_mass_kg=0.0), CAMPAIGNS)  # fmt: skip
+    motor = campaign.config.rocket.motor
+    assert (motor.propellant_mass_kg, motor.grain_length_m, motor.dry_mass_kg) == (1.95, 0.4, 0.0)
+    assert motor.dry_inertia_kgm2 == [0.0, 0.0]
+    assert motor.grain_outer_diameter_m == estimated_grain(find_motor("L1350"))[0]
+
+
+def test_an_existing_campaign_has_no_designation_in_its_set_up():
+    """A campaign naming its curve by file keeps its set-up's JSON (and so its fingerprint and resumable runs): no
+    ``designation`` key, the file digested under ``rocket.motor.thrust_curve``."""
+    campaign = load_campaign(CAMPAIGNS / "custom_rocket.toml")
+    motor = setup(campaign)["config"]["rocket"]["motor"]
+    assert "designation" not in motor and motor["thrust_curve"] == "Cesaroni_4263L1350-P.eng"
+    assert list(campaign.files) == ["rocket.motor.thrust_curve"]
+
+
+@pytest.mark.parametrize(
+    ("motor", "message"),
+    [
+        ({"designation": "L1350", "thrust_curve": "Cesaroni_4263L1350-P.eng"},
+         "rocket.motor: thrust_curve and designation both name the motor; keep one"),
+        ({"propellant_mass_kg": 1.9, "grain_outer_diameter_m": 0.075, "grain_inner_diameter_m": 0.02,
+          "grain_length_m": 0.5}, "rocket.motor: name the motor by thrust_curve (a file) or by designation"),
+        ({"designation": "K400"}, "rocket.motor.designation: 'K400' is ambiguous: AeroTech_K400C, Cesaroni_1597K400-14A"),
+        ({"designation": "L13500"}, "rocket.motor.designation: 'L13500' is not a motor of the library (close: "),
+        ({"designation": "L1350", "propellant_mass_kg": 9.0},
+         "rocket.motor.propellant_mass_kg: 9 kg burnt over the curve's 4280 N·s is a specific impulse of 48 s"),
+        ({"designation": "L1350", "propellant_mass_kg": 1.0},
+         "rocket.motor.propellant_mass_kg: 1 kg burnt over the curve's 4280 N·s is a specific impulse of 436 s"),
+    ],
+    ids=["both", "neither", "ambiguous", "unknown", "isp-low", "isp-high"],
+)  # fmt: skip
+def test_a_motor_badly_named_is_one_line_naming_the_field(motor, message):
+    with pytest.raises(ConfigError) as info:
+        campaign_from_dict(with_motor(**motor), CAMPAIGNS)
+    assert str(info.value).startswith(message) and "\n" not in str(info.value), str(info.value)
+
+
+def test_a_preset_with_a_designation_is_refused():
+    """A preset's dry mass includes its own motor's casing: another motor over it would count a second casing."""
+    with pytest.raises(ConfigError, match=r"^rocket.motor.designation: the preset 'lynx' has its motor by thrust_curve"):
+        parse_campaign(edited('preset = "lynx"', 'preset = "lynx"\nmotor.designation = "M1670"'), CAMPAIGNS)
+
+
+def test_a_propellant_mass_far_from_the_header_is_warned_of():
+    """10 % from the .eng header's 2.0245 kg warns (naming the field); the Lynx campaigns' 1.905 kg (5.9 % under,
+    the thesis's Isp-derived mass) does not, nor a CSV curve (no header)."""
+    far = campaign_from_dict(with_motor(designation="L1350", propellant_mass_kg=1.8), CAMPAIGNS)
+    (line,) = motor_warnings(far)
+    assert "rocket.motor.propellant_mass_kg 1.8 kg differs from the 2.0245 kg" in line and "-11%" in line
+    assert motor_warnings(load_campaign(CAMPAIGNS / "custom_rocket.toml")) == []
+    euroc = load_campaign(CAMPAIGNS / "lynx_euroc_sounding.toml")
+    assert euroc.motor is None and motor_warnings(euroc) == []

@@ -1,6 +1,6 @@
 """Checks of a campaign before and after flying that warn rather than refuse: a nominal rocket that is
 statically unstable (someone may fly one on purpose, to see where it lands), navigation filters on an uncalibrated
-magnetometer or gyroscope, and flights beyond the range of the aerodynamic tables or of the method that built them.
+magnetometer or gyroscope, a propellant mass far from its motor's ``.eng`` header, and flights beyond the range of the aerodynamic tables or of the method that built them.
 Each returns the warning lines (none: all is well), for ``run``, ``fly`` and ``report`` alike."""
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from ..gnc.navigation import NavigationMode
 from ..sim.loads import mass_properties
 from ..sim.params import FlightParams
 from ..sim.state import OUTSIDE_TABLES_QBAR_FRACTION
+from .limits import PROPELLANT_HEADER_TOLERANCE
 from .record import Campaign
 from .model import nominal_params
 
@@ -82,6 +83,17 @@ def calibration_warnings(campaign: Campaign) -> list[str]:
         for sensor, (config, spread, limit, unit, calibrated) in spreads.items()
         if not config.truth_only and spread > limit
     ]
+
+
+def motor_warnings(campaign: Campaign) -> list[str]:
+    """One line if the propellant mass differs from its ``.eng`` header's (``Campaign.motor``) by more than
+    ``PROPELLANT_HEADER_TOLERANCE``; none without a header."""
+    header, given = campaign.motor, campaign.config.rocket.motor.propellant_mass_kg
+    if header is None or abs(given / header.propellant_mass_kg - 1.0) <= PROPELLANT_HEADER_TOLERANCE:
+        return []
+    return [f"{campaign.config.name}: rocket.motor.propellant_mass_kg {given:g} kg differs from the "
+            f"{header.propellant_mass_kg:g} kg of its motor's .eng header ({header.name}, {header.designation}) by "
+            f"{given / header.propellant_mass_kg - 1.0:+.0%}: another motor's mass, or a typo?"]
 
 
 def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: float | None = None,

@@ -13,6 +13,15 @@ FIXED_AVIONICS = ("rate_hz", "latency_s", *("_std", "_std_deg"))
 """Ends of the avionics' numbers that are not dispersible: the schedule (rate, latency) is set per campaign,
 and the per-flight spreads are dispersions themselves."""
 ISP_TOLERANCE = 0.02  # relative mismatch allowed between isp_s and the curve's impulse per propellant mass
+SOLID_ISP_S = (60.0, 300.0)
+"""Band [s] of the specific impulse a curve's total impulse over its propellant's weight can give a solid motor:
+black powder delivers ~80 s and sugar propellants (KNSB) 110-130 s; AP composites 260-265 s at the standard
+70:1 bar expansion (Sutton & Biblarz, Rocket Propulsion Elements, composite propellants), the library's highest
+270 s (AeroTech K400C's header); outside, the propellant mass is another motor's or a unit slip."""
+PROPELLANT_HEADER_TOLERANCE = 0.10
+"""A propellant mass further than this (relative) from its ``.eng`` header's is warned of: another motor's (a
+casing one grain longer holds 20-35 % more: Cesaroni's Pro75 L1350 2.02 kg, its 4-grain L1395 2.48 kg) or a typo; a modelling choice such as the Lynx thesis's 1.905 kg
+for the L1350, the curve's impulse over its measured Isp (5.9 % under the header's 2.0245 kg), is left alone."""
 
 # Physical ranges (docs/conventions.md, Campaign validation): every number is finite and within these, generous
 # for any student or amateur rocket, so that a typo or a unit slip is refused here instead of flying a campaign

@@ -25,6 +25,14 @@ from ..aero.io import load_aero
 from ..aero.model import LinearAero, TableAero, simplify
 from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_increment, with_axial_curve, with_canards
 from ..aero.tables import AeroTables
+from ..dynamics.motor_library import (
+    MotorEntry,
+    MotorLibraryError,
+    casing_inertia_kgm2,
+    estimated_grain,
+    find_motor,
+    read_eng_entry,
+)
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
 from ..env.weather import Weather, WeatherError, read_weather
@@ -38,6 +46,7 @@ from .limits import (
     ISP_TOLERANCE,
     MAX_WIND_MPS,
     NORMAL_REACH_STD,
+    SOLID_ISP_S,
     fixed_reason,
 )
 from .model import airframe_params, sample_period_ticks, sensor_ticks
@@ -319,21 +328,23 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
         overrides = {k: v for k, v in rocket.items() if k != "preset"}
         if not isinstance(rocket["preset"], str):
             raise ConfigError(f"rocket.preset: expected a string (got {rocket['preset']!r})")
-        raw["rocket"] = _deep_merge(preset_rocket(rocket["preset"], base_dir), overrides)
+        preset = preset_rocket(rocket["preset"], base_dir)
+        if "designation" in (overrides.get("motor") or {}) and "thrust_curve" in (preset.get("motor") or {}):
+            raise ConfigError(f"rocket.motor.designation: the preset {shown(rocket['preset'])} has its motor by "
+                              "thrust_curve and its dry mass includes that motor's casing; to fly another motor, "
+                              "write the rocket out without the preset")  # fmt: skip
+        raw["rocket"] = _deep_merge(preset, overrides)
+    if isinstance(raw.get("rocket"), dict):
+        raw["rocket"] = _with_library_motor(raw["rocket"])
     config = _validate(raw)
     _check_geometry(config.rocket)
 
-    path = _resolve_data_file(config.rocket.motor.thrust_curve, base_dir, "motors", "rocket.motor.thrust_curve")
+    field, path = _motor_file(config, base_dir)
     try:
         time_s, thrust_n = read_thrust_curve(path)
     except ThrustCurveError as e:
-        raise ConfigError(f"rocket.motor.thrust_curve: {e}") from None
-    motor = config.rocket.motor
-    if motor.isp_s is not None:
-        curve_isp = cumulative_impulse(time_s, thrust_n)[-1] / (G0 * motor.propellant_mass_kg)
-        if abs(curve_isp - motor.isp_s) > ISP_TOLERANCE * motor.isp_s:
-            raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
-                              f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
+        raise ConfigError(f"{field}: {e}") from None
+    _check_specific_impulse(config, cumulative_impulse(time_s, thrust_n)[-1])
 
     config = _with_sensor_spreads(config)
     nominal = _nominal_values(config)
@@ -345,7 +356,64 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
         inputs = design_inputs(config, airframe_params(config, time_s, thrust_n, aero, wind_profile, weather, nominal))
         schedule = design_schedule(config, inputs)
     return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, wind_profile, files, schedule, inputs,
-                    weather)  # fmt: skip
+                    weather, motor=_eng_header(path))  # fmt: skip
+
+
+def _with_library_motor(rocket: dict) -> dict:
+    """The rocket table with a motor named by ``designation`` completed from the library where the table leaves a
+    value out (the one place these defaults are made): the .eng header's propellant mass, the grain
+    ``estimated_grain`` gives, the casing (total less propellant) as the motor's dry mass, and its inertia as a thin
+    tube of the casing's size (``casing_inertia_kgm2``) of that dry mass. So ``rocket.dry_mass_kg`` is the rocket
+    without its motor, unless the table sets ``dry_mass_kg = 0`` (its dry mass then includes the casing)."""
+    motor = rocket.get("motor")
+    if not (isinstance(motor, dict) and isinstance(motor.get("designation"), str)):
+        return rocket  # the schema says what is wrong (and refuses a thrust_curve beside a designation)
+    try:
+        entry = find_motor(motor["designation"])
+    except MotorLibraryError as e:
+        raise ConfigError(f"rocket.motor.designation: {e}") from None
+    outer, core, length = estimated_grain(entry)
+    dry_mass_kg = motor.get("dry_mass_kg", entry.casing_mass_kg)
+    defaults = {"propellant_mass_kg": entry.propellant_mass_kg, "grain_outer_diameter_m": outer,
+                "grain_inner_diameter_m": core, "grain_length_m": length, "dry_mass_kg": dry_mass_kg}  # fmt: skip
+    if isinstance(dry_mass_kg, int | float):  # else the schema refuses it
+        defaults["dry_inertia_kgm2"] = list(casing_inertia_kgm2(entry, dry_mass_kg))
+    return {**rocket, "motor": {**defaults, **motor}}
+
+
+def _motor_file(config: CampaignConfig, base_dir: Path) -> tuple[str, Path]:
+    """The field naming the motor's thrust curve and the file: the library's for a designation, else
+    ``thrust_curve`` beside the campaign or built in."""
+    motor = config.rocket.motor
+    if motor.designation is not None:
+        return "rocket.motor.designation", find_motor(motor.designation).path
+    return "rocket.motor.thrust_curve", _resolve_data_file(motor.thrust_curve, base_dir, "motors",
+                                                            "rocket.motor.thrust_curve")  # fmt: skip
+
+
+def _check_specific_impulse(config: CampaignConfig, total_impulse_ns: float) -> None:
+    """ConfigError unless the curve's impulse per propellant weight is a solid motor's (``SOLID_ISP_S``), and
+    within ``ISP_TOLERANCE`` of ``isp_s`` where that is given."""
+    motor = config.rocket.motor
+    curve_isp = total_impulse_ns / (G0 * motor.propellant_mass_kg)
+    if not SOLID_ISP_S[0] <= curve_isp <= SOLID_ISP_S[1]:
+        raise ConfigError(f"rocket.motor.propellant_mass_kg: {motor.propellant_mass_kg:g} kg burnt over the curve's "
+                          f"{total_impulse_ns:.0f} N·s is a specific impulse of {curve_isp:.0f} s, outside the "
+                          f"{SOLID_ISP_S[0]:g}-{SOLID_ISP_S[1]:g} s of solid motors")  # fmt: skip
+    if motor.isp_s is not None and abs(curve_isp - motor.isp_s) > ISP_TOLERANCE * motor.isp_s:
+        raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
+                          f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
+
+
+def _eng_header(path: Path) -> MotorEntry | None:
+    """The motor a RASP ``.eng`` file's header describes, None for another kind of file or a header that is not
+    RASP's (the curve alone is read then)."""
+    if path.suffix.lower() != ".eng":
+        return None
+    try:
+        return read_eng_entry(path)
+    except MotorLibraryError:
+        return None
 
 
 def _check_geometry(rocket: RocketConfig) -> None:
@@ -457,8 +525,10 @@ def _nominal_values(config: CampaignConfig) -> dict[str, float]:
 
 
 def _file_digests(config: CampaignConfig, base_dir: Path) -> dict[str, str]:
-    """SHA-256 of each file the campaign reads, by the field naming it (built-in files too)."""
-    named = {"rocket.motor.thrust_curve": (config.rocket.motor.thrust_curve, "motors")}
+    """SHA-256 of each file the campaign reads, by the field naming it (built-in files too; a library motor's by
+    ``rocket.motor.designation``)."""
+    motor_field, motor_path = _motor_file(config, base_dir)
+    named = {}
     aero, wind = config.rocket.aero, config.environment.wind
     if aero.model != "linear" and aero.tables != "buildup" and aero.tables not in BUILTIN_TABLES:
         named["rocket.aero.tables"] = (aero.tables, "aero")
@@ -466,10 +536,9 @@ def _file_digests(config: CampaignConfig, base_dir: Path) -> dict[str, str]:
         named["environment.wind.file"] = (wind.file, "wind")
     if config.environment.atmosphere is not None:
         named["environment.atmosphere.file"] = (config.environment.atmosphere.file, "weather")
-    return {
-        field: hashlib.sha256(_resolve_data_file(name, base_dir, folder, field).read_bytes()).hexdigest()
-        for field, (name, folder) in named.items()
-    }
+    paths = {motor_field: motor_path, **{field: _resolve_data_file(name, base_dir, folder, field)
+                                        for field, (name, folder) in named.items()}}  # fmt: skip
+    return {field: hashlib.sha256(path.read_bytes()).hexdigest() for field, path in paths.items()}
 
 
 def _wind_profile(config: CampaignConfig, base_dir: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:

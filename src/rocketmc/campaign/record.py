@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..aero.model import LinearAero, TableAero
+from ..dynamics.motor_library import MotorEntry
 from ..env.weather import Weather
 from ..gnc.design import Schedule
 from .gains import DesignInputs
@@ -41,3 +42,6 @@ class Campaign:
     overrides: dict[str, object] = dataclasses.field(default_factory=dict)
     """What ``with_overrides`` switched from the file (aero_model, controller, sensors, navigation, and values by
     dotted path; empty for the file as written), kept in the result file's ``overrides`` attribute."""
+    motor: MotorEntry | None = None
+    """The motor its thrust curve's ``.eng`` header describes (the library's for a designation); None for a CSV or
+    ``.rse`` curve, or a header that is not RASP's."""

@@ -16,7 +16,13 @@ from pathlib import Path
 
 from ..errors import RocketmcError
 from ..files import file_stem
-from .checks import VALIDITY_OUTPUTS, calibration_warnings, outputs_validity_warnings, stability_warnings
+from .checks import (
+    VALIDITY_OUTPUTS,
+    calibration_warnings,
+    motor_warnings,
+    outputs_validity_warnings,
+    stability_warnings,
+)
 from ..ellipse import AreaConvergence
 from .flights import check_realization, trajectories
 from .record import Campaign
@@ -32,7 +38,7 @@ TRAJECTORY_INTERVAL_S = 0.1
 
 
 class RunWarning(UserWarning):
-    """A warning about a campaign or its flights (stability, calibration, aerodynamic validity), kept in the
+    """A warning about a campaign or its flights (stability, calibration, the motor, aerodynamic validity), kept in the
     result file's ``warnings`` attribute too."""
 
 
@@ -95,7 +101,7 @@ def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_con
     """``run_campaign``'s loop once its writer holds the partial folder."""
     cfg = campaign.config
     chunk_size, n_chunks = writer.chunk_size, writer.n_chunks
-    campaign_warnings = stability_warnings(campaign) + calibration_warnings(campaign)
+    campaign_warnings = stability_warnings(campaign) + calibration_warnings(campaign) + motor_warnings(campaign)
     for line in campaign_warnings:
         warn(line)
     done = set(writer.completed_chunks())

@@ -84,24 +84,44 @@ Damping = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=0)]
 class MotorConfig(_Strict):
     """Solid motor; positions in the rocket's coordinates [m]."""
 
-    thrust_curve: str = Field(description="RASP .eng or CSV (time s, thrust N); built-in name or path")
-    propellant_mass_kg: Mass = Field(description="propellant mass at ignition, all of it burnt by the curve's end")
+    thrust_curve: str | None = Field(
+        None, description="RASP .eng, RockSim .rse or CSV (time s, thrust N); built-in name or path; this or designation"
+    )
+    designation: str | None = Field(
+        None, exclude_if=lambda name: name is None,
+        description="a motor of the built-in library instead of thrust_curve ('L1350', 'Cesaroni_4263L1350-P'; "
+        "`rocketmc motors` lists them): its curve, and where not given its propellant mass, a grain estimated from "
+        "its casing, and its casing as dry_mass_kg (so rocket.dry_mass_kg is then the rocket without its motor)",
+    )  # absent from the dump when not given: a campaign with a thrust_curve keeps its set-up's bits
+    propellant_mass_kg: Mass = Field(description="propellant mass at ignition, all of it burnt by the curve's end "
+                                     "(a designation gives the .eng header's)")  # fmt: skip
     isp_s: float | None = Field(
         None, gt=0, le=MAX_ISP_S, description="checked against the curve's impulse / propellant"
     )
     ignition_delay_s: Delay = Field(0.0, description="ignition after the start of the simulation, on the rail")
     thrust_scale: Scale = Field(1.0, description="multiplies the thrust curve (the burn time unchanged)")
     nozzle_m: Position = Field(description="the nozzle exit, in the rocket's coordinates [m]")
-    grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward)")
+    grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward); "
+                                             "a designation estimates the grain from its casing")  # fmt: skip
     grain_inner_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M, description="the grain's initial core diameter")
     grain_length_m: Length = Field(description="the grain's length along the axis")
     grain_center_m: Position | None = Field(None, description="default: the grain ends at the nozzle exit")
     dry_mass_kg: float = Field(0.0, ge=0, le=MAX_MASS_KG,
-                               description="casing, nozzle, closures: 0 if the rocket's dry mass has them")
+                               description="casing, nozzle, closures: 0 if the rocket's dry mass has them; a "
+                               "designation's default is the library's total less propellant")  # fmt: skip
     dry_inertia_kgm2: list[Annotated[float, Field(ge=0, le=MAX_INERTIA_KGM2)]] = Field(
-        [0.0, 0.0], min_length=2, max_length=2, description="[axial, transverse] about the motor's dry CG"
+        [0.0, 0.0], min_length=2, max_length=2, description="[axial, transverse] about the motor's dry CG; a "
+        "designation's default is a thin tube of the casing's size and dry_mass_kg"
     )
     dry_cg_m: Position | None = Field(None, description="default: the grain centre")
+
+    @model_validator(mode="after")
+    def _one_motor(self):
+        if (self.thrust_curve is None) == (self.designation is None):
+            raise ValueError("thrust_curve and designation both name the motor; keep one" if self.thrust_curve else
+                             "name the motor by thrust_curve (a file) or by designation (a motor of the built-in "
+                             "library, `rocketmc motors`)")  # fmt: skip
+        return self
 
     @model_validator(mode="after")
     def _core_inside_grain(self):
@@ -267,7 +287,8 @@ class RocketConfig(_Strict):
     nose_position_m: Position = 0.0
     reference_point_m: Position = Field(description="origin of the body frame and, by default, the moment reference")
     dry_mass_kg: Mass = Field(
-        description="the rocket without propellant; the motor's casing included unless rocket.motor.dry_mass_kg gives it apart"
+        description="the rocket without propellant; the motor's casing included unless rocket.motor.dry_mass_kg gives it apart "
+        "(a motor named by rocket.motor.designation gives it apart unless its dry_mass_kg is set to 0)"
     )
     dry_cg_m: Position
     dry_inertia_kgm2: list[Inertia] = Field(min_length=2, max_length=2, description="[axial, transverse]")
