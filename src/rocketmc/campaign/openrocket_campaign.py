@@ -10,7 +10,6 @@ import dataclasses
 import json
 import math
 import re
-import shutil
 import tempfile
 from pathlib import Path
 
