@@ -184,7 +184,7 @@ def test_positions_and_geometry_by_hand(tmp_path):
     design = read_design(write_ork(tmp_path, design_xml()))
     assert (design.nose_kind, design.nose_length_m, design.body_diameter_m) == ("conical", NOSE_L, 2 * R)
     assert design.length_m == pytest.approx(NOSE_L + TUBE_L, abs=1e-12)  # sums of the lengths: rounding only
-    (fin_set,) = design.fins
+    fin_set = design.fins[0].shape
     assert (fin_set.count, fin_set.root_chord_m, fin_set.tip_chord_m, fin_set.span_m) == (3, FIN_C, FIN_C, FIN_S)
     assert fin_set.position_m == pytest.approx(NOSE_L + TUBE_L - FIN_C, abs=1e-12)  # "bottom": aft ends flush
     assert design.lugs == [("Lug", pytest.approx(NOSE_L + (TUBE_L + LUG_L) / 2, abs=1e-12))]  # "middle", aft end
@@ -224,7 +224,7 @@ def test_overrides_of_mass_and_cg(tmp_path):
 def test_elliptical_fins_become_the_trapezoid_of_the_same_span_chord_area_and_centroid(tmp_path):
     stage = nose() + body_tube(fins("ellipticalfinset") + mount())
     design = read_design(write_ork(tmp_path, design_xml(stage=stage)))
-    (fin_set,) = design.fins
+    fin_set = design.fins[0].shape
     # half an ellipse: area π c s / 4, centroid at mid-chord; the trapezoid: tip = c(π/2 − 1), centred sweep
     assert fin_set.tip_chord_m == pytest.approx(FIN_C * (math.pi / 2 - 1), rel=1e-4)  # the 200-point polygon
     assert fin_set.sweep_m == pytest.approx((FIN_C - fin_set.tip_chord_m) / 2, abs=1e-6)

@@ -22,7 +22,7 @@ from xml.etree import ElementTree
 
 import numpy as np
 
-from ..aero.geometry import nose_radius_m
+from ..aero.geometry import FinSet, nose_radius_m
 from ..dynamics.rigid_body import MassProperties
 from . import openrocket_mass as om
 from .errors import ConfigError
@@ -63,18 +63,12 @@ class OpenRocketError(ConfigError):
 
 
 @dataclasses.dataclass(frozen=True)
-class FinSet:
-    """A fin set as rocketmc flies it (trapezoidal) [m, deg]; ``note``: how it was converted, if it was."""
+class ImportedFins:
+    """A fin set as rocketmc flies it (``shape``: trapezoidal, root leading edge from the nose tip), with its
+    OpenRocket name and how it was converted (``note``; empty for trapezoidal fins)."""
 
     name: str
-    count: int
-    root_chord_m: float
-    tip_chord_m: float
-    span_m: float
-    sweep_m: float
-    position_m: float
-    thickness_m: float
-    cant_deg: float
+    shape: FinSet
     note: str = ""
 
 
@@ -121,7 +115,7 @@ class Design:
     body_names: list[str]
     length_m: float
     boat_tail: tuple[str, float, float, float] | None  # (name, length, aft diameter, front end) [m]
-    fins: list[FinSet]
+    fins: list[ImportedFins]
     lugs: list[tuple[str, float]]  # (name, aft end) of each lug or rail button instance
     recovery: list[Recovery]
     mounts: list[tuple[str, ElementTree.Element, float, float]]  # (name, <motormount>, front end, length)
@@ -240,7 +234,7 @@ class _Reader:
         self.root = root
         self.rocket = root.find("rocket")
         self.body: list[tuple[str, str, ElementTree.Element, float, float]] = []  # kind, name, element, top, length
-        self.fins: list[FinSet] = []
+        self.fins: list[ImportedFins] = []
         self.lugs: list[tuple[str, float]] = []
         self.recovery: list[Recovery] = []
         self.mounts: list[tuple[str, ElementTree.Element, float, float]] = []
@@ -595,8 +589,8 @@ class _Reader:
             note = (f"{what} fins flown as the trapezoid of the same span, root chord and {kept}; rocketmc's fins "
                     "are trapezoidal")  # fmt: skip
             self.warnings.append(f"fin set {name!r}: {note}")
-        self.fins.append(FinSet(name, count, shape.root_chord_m, shape.tip_chord_m, shape.span_m, shape.sweep_m,
-                                top_m, thickness, cant, note))
+        self.fins.append(ImportedFins(name, FinSet(count, shape.root_chord_m, shape.tip_chord_m, shape.span_m,
+                                                   shape.sweep_m, top_m, thickness, cant), note))
         body_radius = self._body_radius(parent)
         factor = CROSS_SECTIONS.get((element.findtext("crosssection") or "square").strip(), 1.0)
         density = _material_density(element)

@@ -274,13 +274,14 @@ def _geometry(toml: _Toml, design: Design) -> None:
         toml.table("rocket.geometry.fins", array=True)
         if fins.note:
             toml.comment(f"{fins.name!r}: {fins.note}.")
-        toml.key("count", fins.count, repr(fins.name))
+        shape = fins.shape
+        toml.key("count", shape.count, repr(fins.name))
         for key in ("root_chord_m", "tip_chord_m", "span_m", "sweep_m"):
-            toml.key(key, getattr(fins, key))
-        toml.key("position_m", fins.position_m, "the root's leading edge")
-        toml.key("thickness_m", fins.thickness_m)
-        if fins.cant_deg:
-            toml.key("cant_deg", fins.cant_deg)
+            toml.key(key, getattr(shape, key))
+        toml.key("position_m", shape.position_m, "the root's leading edge")
+        toml.key("thickness_m", shape.thickness_m)
+        if shape.cant_deg:
+            toml.key("cant_deg", shape.cant_deg)
 
 
 def _identifier(name: str, taken: set[str]) -> str:
