@@ -2,7 +2,8 @@
 landing dispersion of result files, ``aero derivatives`` of a rocket, ``gnc design``: the LQI gains of
 a campaign, ``sensors simulate``: one realization's sensor log, ``navigate``: the navigation filters replayed on
 a sensor log, ``fly``: one flight's time series, ``validate`` the simulation against a real flight, ``bench`` this
-machine, ``budget``: the GNC error budget of a closed-loop campaign, ``motors``: the built-in motor library."""
+machine, ``budget``: the GNC error budget of a closed-loop campaign, ``motors``: the built-in motor library,
+``import``: a campaign from an OpenRocket design."""
 
 from __future__ import annotations
 
@@ -342,6 +343,18 @@ def _fly_one(args) -> int:
     return 0
 
 
+def _import(args) -> int:
+    from .campaign.openrocket_campaign import import_openrocket
+    from .files import file_stem
+
+    out = Path(args.out) if args.out else Path(f"{file_stem(Path(args.design).stem)}.toml")
+    _refuse_existing("--out", _output_file("--out", str(out), (".toml",)), args.force)
+    result = import_openrocket(args.design, out, motor=args.motor, simulation=args.simulation, force=args.force)
+    print("\n".join(result.lines))
+    _warn(result.warnings)
+    return 0
+
+
 MAX_STATIC_S = 86_400.0
 """Longest static record ``sensors simulate --static`` flies [s]: a day at 50 Hz is 4.3 million periods."""
 MAX_MACH = 10.0
@@ -634,6 +647,22 @@ def build_parser() -> argparse.ArgumentParser:
     budget.add_argument("--json", action="store_true", help="print the budget as JSON")
     budget.add_argument("--plot", help="write a bar chart of each row's ellipse area to this PNG")
     budget.add_argument("--quiet", action="store_true", help="no progress messages (errors only)")
+    ork = commands.add_parser(
+        "import", help="write a campaign from an OpenRocket design (.ork): geometry, masses, recovery, site, wind, motor",
+        description="Read an OpenRocket design and write a commented campaign file (each value with where it came "
+        "from) and its thrust curve beside it: by default the Thrust column of the chosen simulation's stored flight. "
+        "What rocketmc cannot fly (pods, clusters, a second stage, tube fins, a body whose diameter changes other than "
+        "by an aft boat-tail) is refused in one line naming the component; nothing is written then.",
+    )  # fmt: skip
+    ork.add_argument("design", metavar="ROCKET.ork", help="OpenRocket design (.ork, or its bare rocket.ork XML)")
+    ork.add_argument("--motor", metavar="FILE",
+                     help="a thrust curve (RASP .eng, RockSim .rse or CSV) instead of the stored simulation's")  # fmt: skip
+    ork.add_argument("--simulation", type=COUNT, metavar="K",
+                     help="the design's simulation giving the motor, site, rail and wind, 1-based (default: 1)")  # fmt: skip
+    ork.add_argument("--out", metavar="CAMPAIGN.toml",
+                     help="the campaign file (default: the design's name, .toml, in this folder); the thrust curve is "
+                          "written beside it as <name>_thrust.csv")  # fmt: skip
+    ork.add_argument("--force", action="store_true", help="replace existing campaign and thrust files")
     bench = commands.add_parser(
         "bench", help="measure this machine: flights/s, compile time, peak memory, float32 against float64",
         description="Fly a campaign for each N, aerodynamic model and precision, each in a fresh process: "
@@ -684,7 +713,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("compare needs at least two result files")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget,
-               "motors": _motors}  # fmt: skip
+               "motors": _motors, "import": _import}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk
