@@ -650,13 +650,16 @@ def build_parser() -> argparse.ArgumentParser:
     ork = commands.add_parser(
         "import", help="write a campaign from an OpenRocket design (.ork): geometry, masses, recovery, site, wind, motor",
         description="Read an OpenRocket design and write a commented campaign file (each value with where it came "
-        "from) and its thrust curve beside it: by default the Thrust column of the chosen simulation's stored flight. "
+        "from) flying the design's motor: from the library when it is there, else the Thrust column of the chosen "
+        "simulation's stored flight, written beside the campaign. "
         "What rocketmc cannot fly (pods, clusters, a second stage, tube fins, a body whose diameter changes other than "
         "by an aft boat-tail) is refused in one line naming the component; nothing is written then.",
     )  # fmt: skip
     ork.add_argument("design", metavar="ROCKET.ork", help="OpenRocket design (.ork, or its bare rocket.ork XML)")
-    ork.add_argument("--motor", metavar="FILE",
-                     help="a thrust curve (RASP .eng, RockSim .rse or CSV) instead of the stored simulation's")  # fmt: skip
+    ork.add_argument("--motor", metavar="NAME|FILE",
+                     help="a motor of the library by designation (rocketmc motors), or a thrust curve file (RASP .eng, "
+                          "RockSim .rse or CSV); default: the design's motor if the library has it, else the curve "
+                          "the simulation stored")  # fmt: skip
     ork.add_argument("--simulation", type=COUNT, metavar="K",
                      help="the design's simulation giving the motor, site, rail and wind, 1-based (default: 1)")  # fmt: skip
     ork.add_argument("--out", metavar="CAMPAIGN.toml",

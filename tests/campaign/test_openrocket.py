@@ -14,6 +14,7 @@ from rocketmc.campaign import openrocket_mass as om
 from rocketmc.campaign.openrocket import OpenRocketError, read_design, read_simulation, stored_dry_mass
 from rocketmc.campaign.openrocket_campaign import import_openrocket
 from rocketmc.cli import main
+from rocketmc.dynamics.motor_library import find_motor
 from rocketmc.dynamics.rigid_body import MassProperties, combine_on_axis
 
 CARDBOARD = 680.0  # kg/m³
@@ -252,13 +253,34 @@ def test_the_written_campaign_loads_with_its_sources(tmp_path):
     assert result.thrust_curve.read_text().startswith("time_s,thrust_n\n")
 
 
+def test_a_motor_of_the_library_by_designation(tmp_path):
+    """``--motor NAME``: the library's motor named in the campaign (no thrust file written), its curve, header
+    propellant and casing the library's, the rocket's dry mass still without the motor; the design's own motor when
+    the library has it; an unknown name: one line with the close matches and nothing written."""
+    ork = write_ork(tmp_path, design_xml())
+    result = import_openrocket(ork, tmp_path / "named.toml", motor="k1000t")
+    assert result.thrust_curve is None and sorted(p.name for p in tmp_path.iterdir()) == ["named.toml", "test.ork"]
+    entry = find_motor("K1000T")
+    rocket = load_campaign(tmp_path / "named.toml").config.rocket
+    assert rocket.motor.designation == entry.designation and rocket.motor.thrust_curve is None
+    assert (rocket.motor.propellant_mass_kg, rocket.motor.dry_mass_kg) == (entry.propellant_mass_kg, entry.casing_mass_kg)
+    assert rocket.dry_mass_kg == pytest.approx(expected().mass, rel=REL_SLICING)
+    own = write_ork(tmp_path, design_xml().replace("<designation>X1</designation>", "<designation>K1000T</designation>"),
+                    "own.ork")  # fmt: skip
+    result = import_openrocket(own, tmp_path / "own.toml")
+    assert "motor K1000T-P from the library" in result.lines[0] and result.thrust_curve is None
+    with pytest.raises(OpenRocketError, match=r"^--motor K1000Z: .*K1000T"):
+        import_openrocket(ork, tmp_path / "unknown.toml", motor="K1000Z")
+    assert not (tmp_path / "unknown.toml").exists()
+
+
 @pytest.mark.parametrize("case, named", [
     ("pod", "'Pods' (podset)"),
     ("cluster", "'Motor tube' (innertube): a motor cluster"),
     ("second stage", "'Booster' (stage): a second stage"),
     ("tube fins", "'Tubes' (tubefinset)"),
     ("body step", "'Wide' (bodytube): the body's diameter changes"),
-    ("no simulation", "no simulation to take the motor from"),
+    ("no simulation", "no simulation and its motor 'X1' is not in rocketmc's library"),
     ("corrupt zip", "a corrupt zip"),
     ("no rocket.ork", "a zip without rocket.ork"),
     ("malformed xml", "malformed XML"),

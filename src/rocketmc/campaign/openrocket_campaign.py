@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..dynamics.motor_library import MotorEntry, MotorLibraryError, find_motor
 from ..dynamics.propulsion import ThrustCurveError, read_thrust_curve
 from ..dynamics.rigid_body import MassProperties
 from ..files import replacing
@@ -38,11 +39,11 @@ COMMENT_COLUMN = 37
 
 @dataclasses.dataclass
 class ImportResult:
-    """What ``import_openrocket`` wrote: the campaign and thrust files, what it read (``lines``: one per part, for the
+    """What ``import_openrocket`` wrote: the campaign and thrust files (None: a motor of the library), what it read (``lines``: one per part, for the
     CLI), its warnings, and the mass check: the computed dry rocket and the stored one (None without stored data)."""
 
     campaign: Path
-    thrust_curve: Path
+    thrust_curve: Path | None
     lines: list[str]
     warnings: list[str]
     computed: MassProperties
@@ -87,48 +88,71 @@ class _Toml:
 def import_openrocket(source: str | Path, out: str | Path, motor: str | Path | None = None,
                       simulation: int | None = None, force: bool = False) -> ImportResult:
     """Write the campaign ``out`` from the OpenRocket design ``source``, flying simulation ``simulation`` (1-based;
-    None: the first) with the thrust curve it stored, or the thrust file ``motor`` (RASP .eng, RockSim .rse, CSV),
-    and the thrust curve beside it (``<out stem>_thrust.csv`` or the motor file's copy). Existing files are replaced
+    None: the first) with its motor: ``motor`` by designation from the library (``rocketmc motors``) or as a thrust
+    file (RASP .eng, RockSim .rse, CSV: copied beside the campaign); without it, the design's motor if the library
+    has it, else the thrust curve the simulation stored (``<out stem>_thrust.csv``). Existing files are replaced
     only with ``force``. An ``OpenRocketError`` (one line naming the file and the component) writes nothing."""
     source, out = Path(source), Path(out)
     design = read_design(source)
     sim = read_simulation(design, simulation)
-    if sim is None and motor is None:
-        raise OpenRocketError(f"{source}: the design has no simulation to take the motor from: give --motor FILE")
-    flown = sim is not None and "Thrust" in sim.columns and "Time" in sim.columns
-    if motor is None and not flown:
-        raise OpenRocketError(f"{source}: {sim.label} holds no flight data (run it in OpenRocket and save the file), "
-                              "so no thrust curve: give --motor FILE")  # fmt: skip
     mount = _mount(design, sim, source)
-    thrust_name = f"{out.stem}_thrust{Path(motor).suffix.lower() if motor else '.csv'}"
-    thrust_path = out.with_name(thrust_name)
+    entry = _library_motor(motor, mount)
+    flown = sim is not None and "Thrust" in sim.columns and "Time" in sim.columns
+    if entry is None and motor is None and not flown:
+        without = ("the design has no simulation" if sim is None else
+                   f"{sim.label} holds no flight data (run it in OpenRocket and save the file)")  # fmt: skip
+        raise OpenRocketError(f"{source}: {without} and its motor {mount.designation!r} is not in rocketmc's library, "
+                              "so no thrust curve: give --motor NAME|FILE")  # fmt: skip
+    thrust_name = None if entry else f"{out.stem}_thrust{Path(motor).suffix.lower() if motor else '.csv'}"
+    thrust_path = None if entry else out.with_name(thrust_name)
     for path in (out, thrust_path):
-        if path.exists() and not force:
+        if path is not None and path.exists() and not force:
             raise OpenRocketError(f"{path}: the file exists; use --force to replace it")
     warnings = list(design.warnings)
-    if motor is None:
+    engine, thrust_text = None, None
+    if entry is None and motor is None:
         curve, engine = _stored_curve(sim, warnings), _stored_masses(sim)
         thrust_text = "time_s,thrust_n\n" + "".join(f"{t:.6g},{f:.6g}\n" for t, f in zip(*curve))
-    else:
+    elif entry is None:
         engine, thrust_text = _motor_file(Path(motor), sim, source)
-    text = _campaign_text(source, design, sim, mount, engine, thrust_name, warnings)
+    text = _campaign_text(source, design, sim, mount, entry or engine, thrust_name, warnings)
     with tempfile.TemporaryDirectory() as folder:  # the campaign must load before anything is written
-        (Path(folder) / thrust_name).write_text(thrust_text, encoding="utf-8")
+        if thrust_name is not None:
+            (Path(folder) / thrust_name).write_text(thrust_text, encoding="utf-8")
         try:
             parse_campaign(text, Path(folder))
         except ConfigError as e:
             raise OpenRocketError(f"{source}: rocketmc refuses the campaign made of it: {e}") from None
     for path, content in ((thrust_path, thrust_text), (out, text)):
-        with replacing(path) as partial:
-            partial.write_text(content, encoding="utf-8")
+        if path is not None:
+            with replacing(path) as partial:
+                partial.write_text(content, encoding="utf-8")
     stored = stored_dry_mass(sim, mount) if flown else None
+    motor_line = f"motor {entry.designation} from the library" if entry else f"motor {mount.designation}"
     lines = [f"{design.name} (OpenRocket {design.version}): {design.parts} components, "
-             f"{sim.label if sim else 'no simulation'}, motor {mount.designation}",
+             f"{sim.label if sim else 'no simulation'}, {motor_line}",
              f"dry mass {design.dry.mass:.4g} kg, CG {design.dry.cg_x:.4g} m from the nose tip, inertia "
              f"[{design.dry.ixx:.4g}, {design.dry.iyy:.4g}] kg·m²" + ("" if stored is None else
              f" (stored at t = 0 less the motor: {stored.mass:.4g} kg, {stored.cg_x:.4g} m, [{stored.ixx:.4g}, "
-             f"{stored.iyy:.4g}] kg·m²)"), f"wrote {out} and {thrust_path}"]  # fmt: skip
+             f"{stored.iyy:.4g}] kg·m²)"), f"wrote {out}" + ("" if thrust_path is None else f" and {thrust_path}")]  # fmt: skip
     return ImportResult(out, thrust_path, lines, warnings, design.dry, stored)
+
+
+THRUST_FILE_SUFFIXES = (".eng", ".rse", ".csv")
+"""What ``--motor`` names as a thrust file; anything else is a designation in the library."""
+
+
+def _library_motor(motor: str | Path | None, mount: MotorMount) -> MotorEntry | None:
+    """The library's motor to fly: ``motor`` when it is a designation (not a thrust file), else (no ``motor``) the
+    design's own motor if the library has it; None: a thrust file or the stored curve."""
+    if motor is not None and Path(motor).suffix.lower() in THRUST_FILE_SUFFIXES:
+        return None
+    try:
+        return find_motor(str(motor if motor is not None else mount.designation))
+    except MotorLibraryError as e:
+        if motor is None:
+            return None
+        raise OpenRocketError(f"--motor {motor}: {e}") from None
 
 
 def _mount(design: Design, sim: Simulation | None, source: Path) -> MotorMount:
@@ -193,8 +217,9 @@ def _motor_file(path: Path, sim: Simulation | None, source: Path) -> tuple[tuple
 
 
 def _campaign_text(source: Path, design: Design, sim: Simulation | None, mount: MotorMount,
-                   engine: tuple[float, float, str], thrust_name: str, warnings: list[str]) -> str:
-    """The campaign file's text."""
+                   engine: MotorEntry | tuple[float, float, str], thrust_name: str | None, warnings: list[str]) -> str:
+    """The campaign file's text; ``engine``: a motor of the library, or the (propellant, casing) masses [kg] with
+    their source of the curve ``thrust_name``."""
     toml = _Toml()
     dry = design.dry
     computed = f"computed from {design.parts} components"
@@ -221,8 +246,14 @@ def _campaign_text(source: Path, design: Design, sim: Simulation | None, mount: 
     toml.key("dry_inertia_kgm2", [dry.ixx, dry.iyy], f"[axial, transverse] about the dry CG, {computed}")
     _rear_lug(toml, design, mount, warnings)
 
-    propellant, casing, masses_from = engine
     toml.table("rocket.motor")
+    if isinstance(engine, MotorEntry):
+        toml.comment("The library's motor (`rocketmc motors`): its curve, its header's propellant, the grain estimated "
+                     "from its casing and the casing as the motor's dry mass.")  # fmt: skip
+        toml.key("designation", _string(engine.designation), f"{engine.manufacturer}, in the design: {mount.designation}")
+        toml.key("nozzle_m", mount.nozzle_m, f"aft end of {mount.name!r} plus its overhang")
+        return _rest_of_campaign(toml, design, sim, mount, warnings)
+    propellant, casing, masses_from = engine
     toml.key("thrust_curve", _string(thrust_name), f"{mount.manufacturer} {mount.designation}".strip())
     toml.key("propellant_mass_kg", propellant, masses_from)
     toml.key("nozzle_m", mount.nozzle_m, f"aft end of {mount.name!r} plus its overhang")
@@ -236,7 +267,12 @@ def _campaign_text(source: Path, design: Design, sim: Simulation | None, mount: 
         toml.key("dry_mass_kg", casing, "the casing: the motor's mass after burnout")
         toml.key("dry_inertia_kgm2", [case.ixx, case.iyy], "a solid cylinder, as OpenRocket takes it")
         toml.key("dry_cg_m", mount.top_m + mount.length_m / 2, "the motor's centre")
+    return _rest_of_campaign(toml, design, sim, mount, warnings)
 
+
+def _rest_of_campaign(toml: _Toml, design: Design, sim: Simulation | None, mount: MotorMount,
+                      warnings: list[str]) -> str:
+    """The campaign's text from its aerodynamics on: the build-up, the geometry, recovery, site, rail and wind."""
     toml.table("rocket.aero")
     toml.key("model", '"interpolated"')
     toml.key("tables", '"buildup"', "built from [rocket.geometry]")
