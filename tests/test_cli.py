@@ -102,6 +102,24 @@ def test_aero_derivatives(capsys):
     assert f"{c['CNa']:.3f}" in text and "static margin" in text
 
 
+def test_aero_derivatives_plot(tmp_path, capsys):
+    """--plot: CA0, CNα and the centre of pressure against Mach; the curves hold the printed point (Mach 0.3 is on the
+    default grid) and the figure has three panels; a figure type matplotlib cannot write: exit 2, nothing written."""
+    from rocketmc.campaign.checks import aero_curves
+    from rocketmc.cli import _rocket_campaign
+
+    figure = tmp_path / "aero.png"
+    assert main(["aero", "derivatives", "lynx", "--mach", "0.3", "--json", "--plot", str(figure)]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert figure.stat().st_size > 0
+    curves = aero_curves(_rocket_campaign("lynx"), 0.0)
+    at = next(c for c in curves if abs(c["mach"] - 0.3) < 1e-12)  # the grid's 0.3, to rounding: so are the values
+    assert at["coefficients_per_rad"] == pytest.approx(printed["coefficients_per_rad"], rel=1e-12, abs=1e-15)
+    assert at["center_of_pressure_m"] == pytest.approx(printed["center_of_pressure_m"], rel=1e-12)
+    assert main(["aero", "derivatives", "lynx", "--plot", str(tmp_path / "aero.docx")]) == 2
+    assert not (tmp_path / "aero.docx").exists()
+
+
 def test_gnc_design(tmp_path, capsys):
     """The schedule of a controlled Lynx (linear model, 4 speeds × the 3 default altitudes) as JSON, as a
     table and as a figure; a campaign without [gnc] is one line, exit 2."""

@@ -210,11 +210,16 @@ def _rocket_campaign(rocket: str):
 
 
 def _aero_derivatives(args) -> int:
-    from .campaign.checks import aero_derivatives, format_aero_derivatives
+    from .analysis.plots import plot_aero_curves
+    from .campaign.checks import aero_curves, aero_derivatives, format_aero_derivatives
 
-    result = aero_derivatives(_rocket_campaign(args.rocket), args.mach, args.altitude)
-    result = {"rocket": args.rocket, **result}
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    campaign = _rocket_campaign(args.rocket)
+    result = {"rocket": args.rocket, **aero_derivatives(campaign, args.mach, args.altitude)}
     print(json.dumps(result, indent=2) if args.json else format_aero_derivatives(result))
+    if plot:
+        plot_aero_curves(aero_curves(campaign, args.altitude), campaign.config.name, plot)
+        print(f"wrote {plot}", file=sys.stderr)
     return 0
 
 
@@ -318,7 +323,7 @@ def _navigate(args) -> int:
 
 def _fly_one(args) -> int:
     from .analysis.flight_plots import plot_flight
-    from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings
+    from .campaign.checks import VALIDITY_OUTPUTS, outputs_validity_warnings, preflight_warnings
     from .analysis.flight_record import OUT_SUFFIXES, format_record, write_kml, write_series
     from .campaign.flights import check_realization, flight_record
 
@@ -326,6 +331,7 @@ def _fly_one(args) -> int:
     kml = None if args.kml is None else _refuse_existing("--kml", _output_file("--kml", args.kml, (".kml",)), args.force)
     campaign = _campaign(args.campaign, **_switched(args))
     check_realization(campaign, args.realization)
+    _warn(preflight_warnings(campaign))
     if args.plot_dir:  # before the flight: a folder that cannot be made is said at once
         Path(args.plot_dir).mkdir(parents=True, exist_ok=True)
     say = (lambda line: None) if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
@@ -555,6 +561,8 @@ def build_parser() -> argparse.ArgumentParser:
     derivatives.add_argument("--mach", type=_bounded(float, 0.0, MAX_MACH, f"a Mach number in [0, {MAX_MACH:g}]"), default=0.3, help="Mach number (default 0.3)")
     derivatives.add_argument("--altitude", type=_bounded(float, -2000.0, MAX_ALTITUDE_M, f"in the standard atmosphere's [-2000, {MAX_ALTITUDE_M:.0f}] m"), default=0.0, help="altitude above sea level [m] (default 0)")
     derivatives.add_argument("--json", action="store_true", help="print as JSON")
+    derivatives.add_argument("--plot", metavar="FILE", help="also draw CA0 (the drag at α = 0), CNα and the centre of "
+                             "pressure against Mach, with the CG at liftoff and burnout, into this figure (.png, .svg, .pdf)")  # fmt: skip
     gnc = commands.add_parser("gnc", help="the closed loop of a campaign")
     gnc_commands = gnc.add_subparsers(dest="gnc_command", required=True, parser_class=_Parser)
     design = gnc_commands.add_parser("design", help="the LQI gain schedule designed at set-up, per grid point")

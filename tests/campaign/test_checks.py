@@ -1,5 +1,6 @@
-"""The warnings before and after flying: a statically unstable nominal rocket
-and flights beyond the aerodynamic tables' range or the build-up's subsonic theory."""
+"""The warnings before and after flying: a statically unstable nominal rocket, a body that looks like a unit slip,
+flights beyond the aerodynamic tables' range or the build-up's subsonic theory, a parachute set above the apogee;
+a rail elevation in radians refused."""
 
 from __future__ import annotations
 
@@ -8,12 +9,20 @@ import tomllib
 import pytest
 
 from rocketmc.aero.buildup import MAX_SUBSONIC_MACH
-from rocketmc.campaign import campaign_from_dict, read_campaign_tables
-from rocketmc.campaign.checks import aero_validity_warnings, nominal_static_margins, stability_warnings
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, read_campaign_tables
+from rocketmc.campaign.checks import (
+    aero_validity_warnings,
+    nominal_static_margins,
+    plausibility_warnings,
+    preflight_warnings,
+    recovery_warnings,
+    stability_warnings,
+)
 
 from ..conftest import CAMPAIGNS
 
 RAW = tomllib.loads((CAMPAIGNS / "lynx_ballistic.toml").read_text())
+RAW_GEOMETRY = tomllib.loads((CAMPAIGNS.parent / "src" / "rocketmc" / "data" / "rockets" / "lynx.toml").read_text())["geometry"]
 
 
 def ballistic(**rocket):
@@ -39,6 +48,30 @@ def test_a_dry_cg_moved_aft_is_unstable_and_warned():
     lines = stability_warnings(ballistic(preset="lynx", dry_cg_m=1.83))
     assert len(lines) == 2 and all("statically unstable" in line and "calibers" in line for line in lines), lines
     assert "at liftoff" in lines[0] and "at burnout" in lines[1]
+
+
+def test_a_body_shorter_than_two_diameters_is_warned(lynx):
+    """The Lynx's geometry (2.495 m, 0.150 m: 17 diameters) says nothing; its diameter given as 1.5 m (a slip of a
+    decimal) makes a body 1.7 diameters long: one line naming the field, among the pre-flight warnings."""
+    assert plausibility_warnings(lynx) == [] and preflight_warnings(lynx) == []
+    squat = ballistic(preset="lynx", geometry={**RAW_GEOMETRY, "body_diameter_m": 1.5})
+    (line,) = plausibility_warnings(squat)
+    assert "rocket.geometry.body_diameter_m (1.5 m) is more than half of length_m (2.495 m)" in line, line
+    assert line in preflight_warnings(squat)
+
+
+def test_a_parachute_above_the_apogee_is_warned():
+    """lynx_nominal's main opens 350 m above the pad after apogee: flights to 300, 340 and 350 m open it at apogee
+    (at or below: the trigger is altitude ≤ 350 m once past apogee), one line; all above 350 m, none."""
+    campaign = load_campaign(CAMPAIGNS / "lynx_nominal.toml")
+    assert recovery_warnings(campaign, [1200.0, 351.0, float("nan")]) == []
+    (line,) = recovery_warnings(campaign, [300.0, 340.0, 350.0, 1200.0, float("nan")])
+    assert "rocket.parachutes.1.deploy_altitude_m (main, 350 m) is at or above the apogee of 3 of 4 flight(s)" in line
+
+
+def test_a_rail_elevation_in_radians_is_refused():
+    with pytest.raises(ConfigError, match=r"^launch\.elevation_deg: 1\.466 looks like radians \(84\.0°\)"):
+        campaign_from_dict({**RAW, "launch": {**RAW["launch"], "elevation_deg": 1.466}}, CAMPAIGNS)
 
 
 def test_flights_beyond_the_tables_are_warned(lynx):

@@ -373,3 +373,31 @@ def plot_gains(summary: dict, path: str | Path | None = None) -> Figure:
     if path is not None:
         save_figure(fig, path)
     return fig
+
+
+def plot_aero_curves(curves: list[dict], title: str, path: str | Path | None = None) -> Figure:
+    """Against Mach (``campaign.checks.aero_curves``): the zero-lift axial coefficient CA0 (the drag coefficient at
+    α = 0), the normal-force slope CNα [1/rad], and the centre of pressure with the centre of mass at liftoff and at
+    burnout [m from the nose tip]; saved to ``path`` if given."""
+    mach = [c["mach"] for c in curves]
+    fig = Figure(figsize=(7.0, 8.0), layout="constrained")
+    ax_drag, ax_lift, ax_cp = fig.subplots(3, 1, sharex=True)
+    ax_drag.plot(mach, [c["coefficients_per_rad"]["CA0"] for c in curves])
+    ax_drag.set_ylabel("CA0 (CD at α = 0)")
+    ax_lift.plot(mach, [c["coefficients_per_rad"]["CNa"] for c in curves])
+    ax_lift.set_ylabel("CNα [1/rad]")
+    ax_cp.plot(mach, [c["center_of_pressure_m"] for c in curves], label="centre of pressure")
+    for when, x_m in curves[0]["center_of_mass_m"].items():
+        ax_cp.axhline(x_m, ls="--", color=RUN_COLORS[1 if when == "liftoff" else 2], label=f"centre of mass at {when}")
+    ax_cp.set_ylabel("from the nose tip [m]")
+    ax_cp.invert_yaxis()  # the nose up, as the rocket stands
+    ax_cp.legend(fontsize="small")
+    ax_cp.set_xlabel("Mach")
+    for ax in (ax_drag, ax_lift, ax_cp):
+        ax.grid(True, alpha=0.4)
+    first = curves[0]
+    fig.suptitle(f"{title}\n{first['model']} aerodynamics at {first['altitude_m']:g} m, reference "
+                 f"{first['reference_area_m2'] * 1e4:.4g} cm², d {first['reference_length_m']:g} m", fontsize="medium")  # fmt: skip
+    if path is not None:
+        save_figure(fig, path)
+    return fig

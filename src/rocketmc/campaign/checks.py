@@ -96,6 +96,43 @@ def motor_warnings(campaign: Campaign) -> list[str]:
             f"{given / header.propellant_mass_kg - 1.0:+.0%}: another motor's mass, or a typo?"]
 
 
+SHORTEST_FINENESS = 2.0
+"""A body shorter than this many diameters (nose tip to aft end over the body diameter) is warned of: a radius given as
+the diameter, or a length in another unit, passes the ranges; the squattest flying rockets are still ~4 diameters."""
+
+
+def plausibility_warnings(campaign: Campaign) -> list[str]:
+    """Values that pass their ranges but look like a unit slip: a body shorter than ``SHORTEST_FINENESS`` diameters."""
+    geometry = campaign.config.rocket.geometry
+    if geometry is None or geometry.length_m >= SHORTEST_FINENESS * geometry.body_diameter_m:
+        return []
+    return [f"{campaign.config.name}: rocket.geometry.body_diameter_m ({geometry.body_diameter_m:g} m) is more than "
+            f"half of length_m ({geometry.length_m:g} m): a body {geometry.length_m / geometry.body_diameter_m:.2g} "
+            "diameters long; a radius given as the diameter, or a length in another unit?"]
+
+
+def preflight_warnings(campaign: Campaign) -> list[str]:
+    """Every warning about a campaign before it flies: stability, calibration, motor and plausibility."""
+    return (stability_warnings(campaign) + calibration_warnings(campaign) + motor_warnings(campaign)
+            + plausibility_warnings(campaign))  # fmt: skip
+
+
+def recovery_warnings(campaign: Campaign, apogee_agl_m) -> list[str]:
+    """One line per parachute set to open at an altitude (``deploy_altitude_m``) at or above the apogee [m above the
+    pad] of some of the flights given: there it opens at apogee instead (a main set in feet, or a lower flight than
+    expected)."""
+    flown = np.asarray(apogee_agl_m, float)
+    flown = flown[np.isfinite(flown)]
+    lines = []
+    for i, chute in enumerate(campaign.config.rocket.parachutes):
+        below = int((flown <= chute.deploy_altitude_m).sum()) if chute.deploy_altitude_m is not None else 0
+        if below:
+            lines.append(f"{campaign.config.name}: rocket.parachutes.{i}.deploy_altitude_m ({chute.name}, "
+                         f"{chute.deploy_altitude_m:g} m) is at or above the apogee of {below} of {flown.size} "
+                         f"flight(s) (median apogee {np.median(flown):.0f} m above the pad): it opens at apogee there")  # fmt: skip
+    return lines
+
+
 def aero_validity_warnings(campaign: Campaign, max_mach: float, max_altitude_m: float | None = None,
                            outside_tables: int = 0) -> list[str]:  # fmt: skip
     """Warning lines where flights went beyond the aerodynamic method: ``max_mach`` (the largest Mach number
@@ -129,15 +166,17 @@ VALIDITY_OUTPUTS = ("max_mach", "apogee_agl_m", "max_dynamic_pressure_pa", "max_
 
 
 def outputs_validity_warnings(campaign: Campaign, outputs) -> list[str]:
-    """``aero_validity_warnings`` of flights given by their ``outputs`` (``VALIDITY_OUTPUTS``' names to one value
-    per flight: a result file's /outputs or one flight's summary): the largest Mach number and altitude flown,
-    and how many flights were outside the tables by status 3's criterion."""
+    """``aero_validity_warnings`` and ``recovery_warnings`` of flights given by their ``outputs``
+    (``VALIDITY_OUTPUTS``' names to one value per flight: a result file's /outputs or one flight's summary): the
+    largest Mach number and altitude flown, how many flights were outside the tables by status 3's criterion, and
+    the parachutes set above some flights' apogee."""
     top = lambda values: float(np.nanmax(values)) if np.isfinite(values).any() else float("nan")  # noqa: E731
     values = {name: np.asarray(outputs[name], float) for name in VALIDITY_OUTPUTS}
     qbar = values["max_dynamic_pressure_pa"]
     outside = int((values["max_dynamic_pressure_outside_aero_tables_pa"] > OUTSIDE_TABLES_QBAR_FRACTION * qbar).sum())
-    return aero_validity_warnings(campaign, top(values["max_mach"]),
-                                  top(values["apogee_agl_m"]) + campaign.config.site.altitude_m, outside)  # fmt: skip
+    return aero_validity_warnings(campaign, top(values["max_mach"]), top(values["apogee_agl_m"])
+                                  + campaign.config.site.altitude_m, outside) + recovery_warnings(
+        campaign, values["apogee_agl_m"])  # fmt: skip
 
 
 def aero_derivatives(campaign: Campaign, mach: float, altitude_m: float) -> dict:
@@ -145,28 +184,38 @@ def aero_derivatives(campaign: Campaign, mach: float, altitude_m: float) -> dict
     ``mach`` and ``altitude_m`` [m], with its centre of pressure, CG and static margin at liftoff and at burnout
     (``rocketmc aero derivatives``). Positions are distances from the nose tip [m]; coefficients per rad, rates per
     ω·d/(2V)."""
+    return aero_curves(campaign, altitude_m, [mach])[0]
+
+
+def aero_curves(campaign: Campaign, altitude_m: float, machs=None) -> list[dict]:
+    """``aero_derivatives`` at each of ``machs`` (default: 27 from 0 to the top of the model's Mach axis), the
+    nominal rocket built once: the curves of ``rocketmc aero derivatives --plot``."""
     params = nominal_params(campaign)
     aero = params.rocket.aero
     linear = aero if isinstance(aero, LinearAero) else simplify(aero)
-    c = linear_derivatives(linear, mach, altitude_m)
+    if machs is None:
+        machs = np.linspace(0.0, float(np.max(linear.table.axes[linear.table.axis_names.index("mach")])), 27)
     rocket = campaign.config.rocket
     reference_point = rocket.from_nose(rocket.reference_point_m)  # positions below: from the nose tip
     d = float(linear.reference_length_m)
-    cp = reference_point - centre_of_pressure_x_m(linear, mach, altitude_m)
     cg = {when: reference_point - x for when, x in liftoff_and_burnout_cg_x_m(params).items()}
-    return {
-        "model": rocket.aero.model,
-        "mach": mach,
-        "altitude_m": altitude_m,
-        "reference_area_m2": float(linear.reference_area_m2),
-        "reference_length_m": d,
-        "moment_reference_m": reference_point - float(linear.moment_ref_x_m),
-        "n_canards": int(linear.n_canards),
-        "coefficients_per_rad": c,
-        "center_of_pressure_m": cp,
-        "center_of_mass_m": cg,
-        "static_margin_calibers": {when: (cp - x) / d for when, x in cg.items()},
-    }
+    curves = []
+    for mach in machs:
+        cp = reference_point - centre_of_pressure_x_m(linear, mach, altitude_m)
+        curves.append({
+            "model": rocket.aero.model,
+            "mach": float(mach),
+            "altitude_m": altitude_m,
+            "reference_area_m2": float(linear.reference_area_m2),
+            "reference_length_m": d,
+            "moment_reference_m": reference_point - float(linear.moment_ref_x_m),
+            "n_canards": int(linear.n_canards),
+            "coefficients_per_rad": linear_derivatives(linear, mach, altitude_m),
+            "center_of_pressure_m": cp,
+            "center_of_mass_m": cg,
+            "static_margin_calibers": {when: (cp - x) / d for when, x in cg.items()},
+        })  # fmt: skip
+    return curves
 
 
 def format_aero_derivatives(result: dict) -> str:

@@ -11,6 +11,7 @@ import copy
 import dataclasses
 import difflib
 import hashlib
+import math
 import tomllib
 from collections.abc import Mapping
 from datetime import datetime
@@ -338,6 +339,7 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
         raw["rocket"] = _with_library_motor(raw["rocket"])
     config = _validate(raw)
     _check_geometry(config.rocket)
+    _check_elevation_unit(config.launch.elevation_deg)
 
     field, path = _motor_file(config, base_dir)
     try:
@@ -414,6 +416,14 @@ def _eng_header(path: Path) -> MotorEntry | None:
         return read_eng_entry(path)
     except MotorLibraryError:
         return None
+
+
+def _check_elevation_unit(elevation_deg: float) -> None:
+    """ConfigError if the rail's elevation is at most π/2: radians in a field of degrees (no rail is set 1.6° above
+    the horizon)."""
+    if elevation_deg <= math.pi / 2:
+        raise ConfigError(f"launch.elevation_deg: {elevation_deg:g} looks like radians ({math.degrees(elevation_deg):.1f}°); "
+                          "the rail's elevation is in degrees above the horizon")  # fmt: skip
 
 
 def _check_geometry(rocket: RocketConfig) -> None:

@@ -16,13 +16,7 @@ from pathlib import Path
 
 from ..errors import RocketmcError
 from ..files import file_stem
-from .checks import (
-    VALIDITY_OUTPUTS,
-    calibration_warnings,
-    motor_warnings,
-    outputs_validity_warnings,
-    stability_warnings,
-)
+from .checks import VALIDITY_OUTPUTS, outputs_validity_warnings, preflight_warnings
 from ..ellipse import AreaConvergence
 from .flights import check_realization, trajectories
 from .record import Campaign
@@ -101,7 +95,7 @@ def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_con
     """``run_campaign``'s loop once its writer holds the partial folder."""
     cfg = campaign.config
     chunk_size, n_chunks = writer.chunk_size, writer.n_chunks
-    campaign_warnings = stability_warnings(campaign) + calibration_warnings(campaign) + motor_warnings(campaign)
+    campaign_warnings = preflight_warnings(campaign)
     for line in campaign_warnings:
         warn(line)
     done = set(writer.completed_chunks())
@@ -146,7 +140,7 @@ def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_con
                  f"bootstrap interval {100 * convergence.width:.2f} % of it wide (target {until_converged_pct:g} %)")  # fmt: skip
     validity = []
 
-    def kept_warnings(f):  # the gathered flights' aerodynamic validity, with the stability warnings, in the file
+    def kept_warnings(f):  # the gathered flights' validity, with the pre-flight warnings, in the file
         validity.extend(outputs_validity_warnings(campaign, {n: f["outputs"][n][()] for n in VALIDITY_OUTPUTS}))
         return campaign_warnings + validity
 
