@@ -20,6 +20,7 @@ from .limits import (
     DEFAULT_SPEEDS_MPS,
     MAX_ALTITUDE_M,
     MAX_ANOMALY_NT,
+    MAX_BURN_TIME_S,
     MAX_AREA_M2,
     MAX_CANARD_LIMIT_DEG,
     MAX_COEFFICIENT,
@@ -100,6 +101,11 @@ class MotorConfig(_Strict):
     )
     ignition_delay_s: Delay = Field(0.0, description="ignition after the start of the simulation, on the rail")
     thrust_scale: Scale = Field(1.0, description="multiplies the thrust curve (the burn time unchanged)")
+    burn_time_s: float | None = Field(
+        None, gt=0, le=MAX_BURN_TIME_S, exclude_if=lambda seconds: seconds is None,
+        description="reshapes the curve to this burn time keeping its total impulse: its times × burn_time_s / its "
+        "own burn time, its thrusts ÷ that (RocketPy's reshape_thrust_curve); dispersible (none: the curve's own)",
+    )  # absent from the dump when not given: a campaign without it keeps its set-up's bits
     nozzle_m: Position = Field(description="the nozzle exit, in the rocket's coordinates [m]")
     grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward); "
                                              "a designation estimates the grain from its casing")  # fmt: skip
@@ -256,6 +262,11 @@ class ParachuteConfig(_Strict):
     delay_s: Delay = Field(0.0, description="from the trigger to the start of opening")
     opening_time_s: Delay = Field(0.0, description="the drag area grows linearly over it")
     attach_m: Position
+    releases: str | None = Field(
+        None, exclude_if=lambda name: name is None,
+        description="the name of another parachute cut away when this one starts opening (delay_s after its "
+        "trigger), its drag gone from then: a drogue released by the main (none: every canopy stays attached)",
+    )  # absent from the dump when not given: a campaign without it keeps its set-up's bits
 
 
 class AirbrakesConfig(_Strict):
@@ -292,7 +303,14 @@ class RocketConfig(_Strict):
     )
     dry_cg_m: Position
     dry_inertia_kgm2: list[Inertia] = Field(min_length=2, max_length=2, description="[axial, transverse]")
-    rear_lug_m: Position
+    rear_lug_m: Position = Field(description="the rear launch lug's aft end or rail button, in the rocket's coordinates "
+                                 "[m]; alone, the rocket leaves the rail when it passes the rail's top")
+    upper_lug_m: Position | None = Field(
+        None, exclude_if=lambda position: position is None,
+        description="the upper (forward) of two rail buttons or lugs, in the rocket's coordinates [m]: the rocket leaves "
+        "the rail when it passes the rail's top, the pivot on the rear one until that leaves too not modelled (none: "
+        "one lug, rear_lug_m)",
+    )  # absent from the dump when not given: a campaign with one lug keeps its set-up's bits
     canopy_roll_damping: Damping = Field(-5.0, description="roll damping Clp under an open canopy, per ω·d/(2V)")
     motor: MotorConfig
     aero: AeroConfig = AeroConfig()
@@ -314,8 +332,22 @@ class RocketConfig(_Strict):
         names = [p.name for p in self.parachutes]
         if len(set(names)) != len(names):
             raise ValueError(f"parachute names must be unique, got {names}")
+        released = [p.releases for p in self.parachutes if p.releases is not None]
+        for i, chute in enumerate(self.parachutes):
+            if chute.releases is not None and (chute.releases not in names or chute.releases == chute.name):
+                raise ValueError(f"parachutes.{i}.releases: {chute.releases!r} is not another parachute of the "
+                                 f"rocket ({', '.join(names)})")  # fmt: skip
+            if released.count(chute.name) > 1:
+                raise ValueError(f"parachute {chute.name!r} is released by more than one parachute")
         if self.aero.model != "linear" and self.aero.tables == "buildup" and self.geometry is None:
             raise ValueError("aero.tables = 'buildup' needs the rocket's [rocket.geometry]")
+        return self
+
+    @model_validator(mode="after")
+    def _upper_lug_forward(self):
+        if self.upper_lug_m is not None and not self.from_nose(self.upper_lug_m) < self.from_nose(self.rear_lug_m):
+            raise ValueError(f"upper_lug_m ({self.upper_lug_m:g} m) must be forward of rear_lug_m "
+                             f"({self.rear_lug_m:g} m), nearer the nose")  # fmt: skip
         return self
 
 
@@ -331,7 +363,8 @@ class SiteConfig(_Strict):
 class LaunchConfig(_Strict):
     """The launch rail."""
 
-    rail_length_m: Length = Field(description="the rail's length; the rocket leaves when its rear lug passes the end")
+    rail_length_m: Length = Field(description="the rail's length; the rocket leaves when its upper lug (rocket.upper_lug_m, "
+                                  "else rear_lug_m) passes the end")
     elevation_deg: float = Field(gt=0, le=90, description="rail angle above the horizon")
     azimuth_deg: Direction = Field(description="clockwise from north")
 
@@ -476,6 +509,11 @@ class EnvironmentConfig(_Strict):
         None, description="the day's atmosphere and wind from a file; None: the standard atmosphere and "
                           "[environment.wind]")  # fmt: skip
     magnetic_field: MagneticFieldConfig = MagneticFieldConfig()
+    gravity: Literal["constant", "inverse_square"] = Field(
+        "constant", exclude_if=lambda model: model == "constant",
+        description="'constant': standard gravity 9.80665 m/s² everywhere; 'inverse_square': 9.80665·(r0/(r0 + z))² "
+        "at the altitude z above mean sea level, r0 = 6356766 m (US Standard Atmosphere 1976)",
+    )  # absent from the dump when constant: a campaign without it keeps its set-up's bits
 
     @model_validator(mode="after")
     def _one_wind(self):
