@@ -103,8 +103,9 @@ class MotorConfig(_Strict):
     thrust_scale: Scale = Field(1.0, description="multiplies the thrust curve (the burn time unchanged)")
     burn_time_s: float | None = Field(
         None, gt=0, le=MAX_BURN_TIME_S, exclude_if=lambda seconds: seconds is None,
-        description="reshapes the curve to this burn time keeping its total impulse: its times × burn_time_s / its "
-        "own burn time, its thrusts ÷ that (RocketPy's reshape_thrust_curve); dispersible (none: the curve's own)",
+        description="reshapes the curve to this burn time keeping its total impulse: its times scaled to end at "
+        "burn_time_s, its thrusts by the inverse ratio (RocketPy's reshape_thrust_curve); dispersible (none: the "
+        "curve's own)",
     )  # absent from the dump when not given: a campaign without it keeps its set-up's bits
     nozzle_m: Position = Field(description="the nozzle exit, in the rocket's coordinates [m]")
     grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward); "
