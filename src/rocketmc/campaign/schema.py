@@ -82,18 +82,23 @@ DampingCoefficient = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=MAX_
 Damping = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=0)]
 
 
+def _added(default, description: str, **constraints):
+    """A field added after campaigns were stored, left out of the dump at its ``default``: a campaign that does not
+    write it keeps its configuration and set-up fingerprint bit for bit."""
+    return Field(default, exclude_if=lambda value: value == default, description=description, **constraints)
+
+
 class MotorConfig(_Strict):
     """Solid motor; positions in the rocket's coordinates [m]."""
 
     thrust_curve: str | None = Field(
         None, description="RASP .eng, RockSim .rse or CSV (time s, thrust N); built-in name or path; this or designation"
     )
-    designation: str | None = Field(
-        None, exclude_if=lambda name: name is None,
-        description="a motor of the built-in library instead of thrust_curve ('L1350', 'Cesaroni_4263L1350-P'; "
+    designation: str | None = _added(
+        None, "a motor of the built-in library instead of thrust_curve ('L1350', 'Cesaroni_4263L1350-P'; "
         "`rocketmc motors` lists them): its curve, and where not given its propellant mass, a grain estimated from "
         "its casing, and its casing as dry_mass_kg (so rocket.dry_mass_kg is then the rocket without its motor)",
-    )  # absent from the dump when not given: a campaign with a thrust_curve keeps its set-up's bits
+    )
     propellant_mass_kg: Mass = Field(description="propellant mass at ignition, all of it burnt by the curve's end "
                                      "(a designation gives the .eng header's)")  # fmt: skip
     isp_s: float | None = Field(
@@ -101,12 +106,11 @@ class MotorConfig(_Strict):
     )
     ignition_delay_s: Delay = Field(0.0, description="ignition after the start of the simulation, on the rail")
     thrust_scale: Scale = Field(1.0, description="multiplies the thrust curve (the burn time unchanged)")
-    burn_time_s: float | None = Field(
-        None, gt=0, le=MAX_BURN_TIME_S, exclude_if=lambda seconds: seconds is None,
-        description="reshapes the curve to this burn time keeping its total impulse: its times scaled to end at "
+    burn_time_s: float | None = _added(
+        None, "reshapes the curve to this burn time keeping its total impulse: its times scaled to end at "
         "burn_time_s, its thrusts by the inverse ratio (RocketPy's reshape_thrust_curve); dispersible (none: the "
-        "curve's own)",
-    )  # absent from the dump when not given: a campaign without it keeps its set-up's bits
+        "curve's own)", gt=0, le=MAX_BURN_TIME_S,
+    )
     nozzle_m: Position = Field(description="the nozzle exit, in the rocket's coordinates [m]")
     grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward); "
                                              "a designation estimates the grain from its casing")  # fmt: skip
@@ -263,11 +267,10 @@ class ParachuteConfig(_Strict):
     delay_s: Delay = Field(0.0, description="from the trigger to the start of opening")
     opening_time_s: Delay = Field(0.0, description="the drag area grows linearly over it")
     attach_m: Position
-    releases: str | None = Field(
-        None, exclude_if=lambda name: name is None,
-        description="the name of another parachute cut away when this one starts opening (delay_s after its "
+    releases: str | None = _added(
+        None, "the name of another parachute cut away when this one starts opening (delay_s after its "
         "trigger), its drag gone from then: a drogue released by the main (none: every canopy stays attached)",
-    )  # absent from the dump when not given: a campaign without it keeps its set-up's bits
+    )
 
 
 class AirbrakesConfig(_Strict):
@@ -306,12 +309,11 @@ class RocketConfig(_Strict):
     dry_inertia_kgm2: list[Inertia] = Field(min_length=2, max_length=2, description="[axial, transverse]")
     rear_lug_m: Position = Field(description="the rear launch lug's aft end or rail button, in the rocket's coordinates "
                                  "[m]; alone, the rocket leaves the rail when it passes the rail's top")
-    upper_lug_m: Position | None = Field(
-        None, exclude_if=lambda position: position is None,
-        description="the upper (forward) of two rail buttons or lugs, in the rocket's coordinates [m]: the rocket leaves "
+    upper_lug_m: Position | None = _added(
+        None, "the upper (forward) of two rail buttons or lugs, in the rocket's coordinates [m]: the rocket leaves "
         "the rail when it passes the rail's top, the pivot on the rear one until that leaves too not modelled (none: "
         "one lug, rear_lug_m)",
-    )  # absent from the dump when not given: a campaign with one lug keeps its set-up's bits
+    )
     canopy_roll_damping: Damping = Field(-5.0, description="roll damping Clp under an open canopy, per ω·d/(2V)")
     motor: MotorConfig
     aero: AeroConfig = AeroConfig()
@@ -510,11 +512,10 @@ class EnvironmentConfig(_Strict):
         None, description="the day's atmosphere and wind from a file; None: the standard atmosphere and "
                           "[environment.wind]")  # fmt: skip
     magnetic_field: MagneticFieldConfig = MagneticFieldConfig()
-    gravity: Literal["constant", "inverse_square"] = Field(
-        "constant", exclude_if=lambda model: model == "constant",
-        description="'constant': standard gravity 9.80665 m/s² everywhere; 'inverse_square': 9.80665·(r0/(r0 + z))² "
+    gravity: Literal["constant", "inverse_square"] = _added(
+        "constant", "'constant': standard gravity 9.80665 m/s² everywhere; 'inverse_square': 9.80665·(r0/(r0 + z))² "
         "at the altitude z above mean sea level, r0 = 6356766 m (US Standard Atmosphere 1976)",
-    )  # absent from the dump when constant: a campaign without it keeps its set-up's bits
+    )
 
     @model_validator(mode="after")
     def _one_wind(self):
