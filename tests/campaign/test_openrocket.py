@@ -253,6 +253,21 @@ def test_the_written_campaign_loads_with_its_sources(tmp_path):
     assert result.thrust_curve.read_text().startswith("time_s,thrust_n\n")
 
 
+def test_two_rail_buttons_are_written_as_the_rear_and_the_upper_lug(tmp_path):
+    """Two rail buttons 0.25 m apart: rear_lug_m the aft one, upper_lug_m the forward one, whose passing the rail's
+    top frees the rocket (a button: its centre)."""
+    buttons = _component("railbutton", "Buttons", f"{_material(PLASTIC)}<instancecount>2</instancecount>"
+                         "<instanceseparation>0.25</instanceseparation><outerdiameter>0.01</outerdiameter>"
+                         "<innerdiameter>0.006</innerdiameter><height>0.008</height>", "top", 0.1)  # fmt: skip
+    stage = nose() + body_tube(fins() + buttons + mount())
+    out = tmp_path / "buttons.toml"
+    import_openrocket(write_ork(tmp_path, design_xml(stage=stage)), out)
+    rocket = load_campaign(out).config.rocket
+    assert rocket.upper_lug_m == pytest.approx(NOSE_L + 0.1, rel=1e-6)  # written to 7 digits
+    assert rocket.rear_lug_m == pytest.approx(NOSE_L + 0.35, rel=1e-6)
+    assert "the rocket leaves the rail when it passes the top" in out.read_text()
+
+
 def test_a_motor_of_the_library_by_designation(tmp_path):
     """``--motor NAME``: the library's motor named in the campaign (no thrust file written), its curve, header
     propellant and casing the library's, the rocket's dry mass still without the motor; the design's own motor when

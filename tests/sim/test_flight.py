@@ -24,7 +24,7 @@ from rocketmc.dynamics import RigidBodyState
 from rocketmc.env import G0, isa
 from rocketmc.math import Vec3
 from rocketmc.math.table import Table
-from rocketmc.sim.events import rail_start_n
+from rocketmc.sim.events import rail_start_n, rail_travel_m
 from rocketmc.sim.flight import fly, initial_state, simulate_one
 from rocketmc.sim.loads import derivatives, mass_properties
 from rocketmc.sim.outputs import METRICS, flight_summary, metric
@@ -236,7 +236,7 @@ def test_vacuum_rail_exit_matches_the_rail_ode(vacuum_flight, settings):
         return [y[1], a if (y[1] > 0.0 or a > 0.0) else 0.0]
 
     # the rear lug leaves the top of the rail after this travel of the nozzle from the pad
-    travel = float(p.launch.rail_length_m - (rocket.rear_lug_x_m - motor.nozzle_x_m))
+    travel = float(rail_travel_m(p))
     exit_event = lambda t, y: y[0] - travel  # noqa: E731
     exit_event.terminal = True
     stops = [ignition] + list(ignition + curve_t[1:])

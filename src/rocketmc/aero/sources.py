@@ -89,14 +89,32 @@ def with_canards(tables: AeroTables, geometry: RocketGeometry) -> AeroTables:
     return dataclasses.replace(tables, canards=panels, source=f"{tables.source}; canards from the build-up")
 
 
+def _with_mach_points(body: GriddedCoefficients, mach) -> GriddedCoefficients:
+    """``body`` with the Mach numbers ``mach`` strictly inside its Mach axis and not on it inserted there, every
+    output interpolated linearly along Mach at them: the table's multilinear interpolant is unchanged."""
+    k = body.axis_names.index("mach")
+    axis = body.axes[k]
+    mach = np.asarray(mach, dtype=float)
+    new = mach[(mach > axis[0]) & (mach < axis[-1]) & ~np.isin(mach, axis)]
+    if new.size == 0:
+        return body
+    merged = np.union1d(axis, new)
+    i = np.clip(np.searchsorted(axis, merged, side="right") - 1, 0, axis.size - 2)
+    weight = ((merged - axis[i]) / (axis[i + 1] - axis[i])).reshape([-1 if n == k else 1 for n in range(body.values.ndim)])
+    values = np.take(body.values, i, axis=k) * (1.0 - weight) + np.take(body.values, i + 1, axis=k) * weight
+    return dataclasses.replace(body, axes=body.axes[:k] + (merged,) + body.axes[k + 1 :], values=values)
+
+
 def with_axial_curve(tables: AeroTables, mach, cd) -> AeroTables:
     """``tables`` whose zero-lift axial force follows a Cd-vs-Mach curve (linear between points,
     constant beyond them); the dependence on α, β and altitude of the table is kept as an increment
-    over its own zero-angle value at each Mach."""
-    body = tables.body
-    names = body.axis_names
-    if "mach" not in names:
+    over its own zero-angle value at each Mach. The curve's points inside the table's Mach range
+    and between its grid points are inserted in the Mach axis (``_with_mach_points``), so that a
+    curve finer than the grid flies as given."""
+    if "mach" not in tables.body.axis_names:
         raise ValueError("a Cd-vs-Mach curve needs a body table with a mach axis")
+    body = _with_mach_points(tables.body, mach)
+    names = body.axis_names
     index = []
     for name, axis in zip(names, body.axes):
         zeros = np.flatnonzero(axis == 0.0) if name in ("alpha", "beta") else None

@@ -298,7 +298,8 @@ def simulated_flight(campaign: Campaign, duration_s: float = 150.0) -> tuple[pd.
 
         def at(state):
             d_body, diagnostics = derivatives(state.t, state.body, p, neutral, Vec3.zeros(state.t), state.events)
-            gravity_free = d_body.v_n - Vec3(0.0, 0.0, G0)
+            gravity = p.environment.gravity_mps2(p.environment.site_altitude_m - state.body.r_n.z)
+            gravity_free = d_body.v_n - Vec3(0.0, 0.0, gravity)
             return state.body.q_nb.rotate_inverse(gravity_free).x, diagnostics.mach
 
         force, mach = jax.vmap(at)(trajectory)

@@ -27,6 +27,7 @@ from ..dynamics.rigid_body import MassProperties
 from ..env.atmosphere import G0, AtmosphereProfile, air
 from ..gnc.design import FlownLoopUnstable, PlantPoint, Schedule, gain_schedule
 from ..math.vectors import Vec3
+from ..sim.events import rail_travel_m
 from ..sim.loads import mass_properties
 from ..sim.params import FlightParams, Launch
 from .errors import ConfigError
@@ -163,14 +164,14 @@ def nominal_estimate(params: FlightParams, aero: LinearAero, thrust_n, propellan
     pad's altitude (no power-on change, no airbrakes) and the air's density and speed of sound at
     ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for Lynx's window (~60 ms to its apogee). ConfigError if the
     flight is not in the air in the window."""
-    site, motor = float(params.environment.site_altitude_m), params.rocket.motor
+    site = float(params.environment.site_altitude_m)
     heights = ESTIMATE_HEIGHTS_M
     mach_axis = np.asarray(aero.table.axes[aero.table.axis_names.index("mach")])
     ca0 = float(aero.drag_scale) * np.array([linear_derivatives(aero, m, site)["CA0"] for m in mach_axis])
     area, dry_kg = float(aero.reference_area_m2), float(params.rocket.dry_mass_kg)
     sin_e = -float(params.launch.rail_direction_n.z)
     cos_e = math.sqrt(1.0 - sin_e**2)
-    travel = float(params.launch.rail_length_m - (params.rocket.rear_lug_x_m - motor.nozzle_x_m))
+    travel = float(rail_travel_m(params))
 
     dt = ESTIMATE_DT_S
     x = z = vx = vz = 0.0  # along the azimuth and up from the start [m], velocity [m/s]

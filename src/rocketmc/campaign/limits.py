@@ -38,6 +38,7 @@ MAX_ISP_S = 500.0  # above any chemical motor (hydrogen-oxygen in vacuum: ~450 s
 MAX_SCALE = 10.0  # multipliers of a measured curve (thrust, drag, wind): ×10 is a unit slip, not a dispersion
 MAX_DELAY_S = 60.0  # ignition delay, parachute delay and opening time: longer is a flight without that event
 MAX_FLIGHT_TIME_S = 3600.0  # a descent under a main canopy from 10 km takes under ~2000 s
+MAX_BURN_TIME_S = 100.0  # a reshaped thrust curve: the longest amateur solid motors burn under ~30 s
 MAX_ALTITUDE_M = 100_000.0  # heights above ground: the standard atmosphere ends at 47 km (status 4 above)
 MAX_WIND_MPS = 150.0  # above the strongest jet-stream winds measured (~110 m/s)
 MAX_MACH = 25.0  # Mach axes: beyond any sounding rocket

@@ -90,6 +90,7 @@ def airframe_params(
         site_altitude_m=jnp.asarray(config.site.altitude_m, dtype=float),
         wind=_wind(config, wind_profile, weather, v),
         atmosphere=_atmosphere(weather),
+        gravity=config.environment.gravity,
     )
     return FlightParams(rocket, launch, environment)
 
@@ -106,9 +107,12 @@ def _rocket(cfg: CampaignConfig, thrust_time_s, thrust_n, table_aero: TableAero 
         else body_x(f"{m}.nozzle_m") + 0.5 * v[f"{m}.grain_length_m"]
     )
     motor_dry_x = grain_center if cfg.rocket.motor.dry_cg_m is None else body_x(f"{m}.dry_cg_m")
-    scaled_thrust_n = jnp.asarray(thrust_n) * v[f"{m}.thrust_scale"]
+    time_s, scaled_thrust_n = jnp.asarray(thrust_time_s), jnp.asarray(thrust_n) * v[f"{m}.thrust_scale"]
+    if cfg.rocket.motor.burn_time_s is not None:  # the curve reshaped to the burn time, each segment's impulse kept
+        stretch = v[f"{m}.burn_time_s"] / float(thrust_time_s[-1])
+        time_s, scaled_thrust_n = time_s * stretch, scaled_thrust_n / stretch
     motor = Motor(
-        time_s=jnp.asarray(thrust_time_s),
+        time_s=time_s,
         thrust_n=scaled_thrust_n,
         impulse_ns=jnp.asarray(cumulative_impulse(thrust_time_s, thrust_n)) * v[f"{m}.thrust_scale"],
         ignition_time_s=v[f"{m}.ignition_delay_s"],
@@ -151,6 +155,8 @@ def _rocket(cfg: CampaignConfig, thrust_time_s, thrust_n, table_aero: TableAero 
                 opening_time_s=v[f"{c}.opening_time_s"],
                 attach_x_m=body_x(f"{c}.attach_m"),
                 name=chute.name,
+                released_by=next((j for j, other in enumerate(cfg.rocket.parachutes) if other.releases == chute.name),
+                                 None),
             )
         )
 
@@ -163,7 +169,7 @@ def _rocket(cfg: CampaignConfig, thrust_time_s, thrust_n, table_aero: TableAero 
         dry_cg_x_m=dry.cg_x,
         dry_ixx_kgm2=dry.ixx,
         dry_iyy_kgm2=dry.iyy,
-        rear_lug_x_m=body_x("rocket.rear_lug_m"),
+        exit_lug_x_m=body_x("rocket.rear_lug_m" if cfg.rocket.upper_lug_m is None else "rocket.upper_lug_m"),
         motor=motor,
         aero=aero,
         parachutes=tuple(parachutes),

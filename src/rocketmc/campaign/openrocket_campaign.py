@@ -244,7 +244,7 @@ def _campaign_text(source: Path, design: Design, sim: Simulation | None, mount: 
     toml.key("dry_mass_kg", dry.mass, f"without the motor, {computed}")
     toml.key("dry_cg_m", dry.cg_x, computed)
     toml.key("dry_inertia_kgm2", [dry.ixx, dry.iyy], f"[axial, transverse] about the dry CG, {computed}")
-    _rear_lug(toml, design, mount, warnings)
+    _lugs(toml, design, mount, warnings)
 
     toml.table("rocket.motor")
     if isinstance(engine, MotorEntry):
@@ -282,9 +282,10 @@ def _rest_of_campaign(toml: _Toml, design: Design, sim: Simulation | None, mount
     return toml.text()
 
 
-def _rear_lug(toml: _Toml, design: Design, mount: MotorMount, warnings: list[str]) -> None:
-    """``rear_lug_m``: the aft end of the rearmost launch lug or rail button (rocketmc's rocket leaves the rail when
-    it passes the rail's top); the nozzle when there is none."""
+def _lugs(toml: _Toml, design: Design, mount: MotorMount, warnings: list[str]) -> None:
+    """``rear_lug_m``: the rearmost launch lug or rail button, and ``upper_lug_m``: the foremost when it is forward of
+    that (the rocket leaves the rail when the upper one passes the rail's top, the rear one alone when there is no
+    other); each a button's centre or a lug's aft end. The nozzle when there is none."""
     if not design.lugs:
         warnings.append("no launch lug or rail button: the rear lug is put at the nozzle, the rocket leaving the rail "
                         "after travelling its whole length (OpenRocket's own rule)")  # fmt: skip
@@ -293,7 +294,8 @@ def _rear_lug(toml: _Toml, design: Design, mount: MotorMount, warnings: list[str
     rear, upper = max(design.lugs, key=lambda lug: lug[1]), min(design.lugs, key=lambda lug: lug[1])
     toml.key("rear_lug_m", rear[1], f"{rear[0]!r}, the rearmost (a button: its centre; a lug: its aft end)")
     if upper[1] < rear[1]:
-        toml.comment(f"The upper one, {upper[0]!r}, is at {upper[1]:.4g} m.")
+        toml.key("upper_lug_m", upper[1], f"{upper[0]!r}, the foremost: the rocket leaves the rail when it passes "
+                                          "the top")  # fmt: skip
 
 
 def _geometry(toml: _Toml, design: Design) -> None:

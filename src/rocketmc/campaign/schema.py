@@ -20,6 +20,7 @@ from .limits import (
     DEFAULT_SPEEDS_MPS,
     MAX_ALTITUDE_M,
     MAX_ANOMALY_NT,
+    MAX_BURN_TIME_S,
     MAX_AREA_M2,
     MAX_CANARD_LIMIT_DEG,
     MAX_COEFFICIENT,
@@ -81,18 +82,23 @@ DampingCoefficient = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=MAX_
 Damping = Annotated[float, Field(ge=-MAX_DAMPING_COEFFICIENT, le=0)]
 
 
+def _added(default, description: str, **constraints):
+    """A field added after campaigns were stored, left out of the dump at its ``default``: a campaign that does not
+    write it keeps its configuration and set-up fingerprint bit for bit."""
+    return Field(default, exclude_if=lambda value: value == default, description=description, **constraints)
+
+
 class MotorConfig(_Strict):
     """Solid motor; positions in the rocket's coordinates [m]."""
 
     thrust_curve: str | None = Field(
         None, description="RASP .eng, RockSim .rse or CSV (time s, thrust N); built-in name or path; this or designation"
     )
-    designation: str | None = Field(
-        None, exclude_if=lambda name: name is None,
-        description="a motor of the built-in library instead of thrust_curve ('L1350', 'Cesaroni_4263L1350-P'; "
+    designation: str | None = _added(
+        None, "a motor of the built-in library instead of thrust_curve ('L1350', 'Cesaroni_4263L1350-P'; "
         "`rocketmc motors` lists them): its curve, and where not given its propellant mass, a grain estimated from "
         "its casing, and its casing as dry_mass_kg (so rocket.dry_mass_kg is then the rocket without its motor)",
-    )  # absent from the dump when not given: a campaign with a thrust_curve keeps its set-up's bits
+    )
     propellant_mass_kg: Mass = Field(description="propellant mass at ignition, all of it burnt by the curve's end "
                                      "(a designation gives the .eng header's)")  # fmt: skip
     isp_s: float | None = Field(
@@ -100,6 +106,11 @@ class MotorConfig(_Strict):
     )
     ignition_delay_s: Delay = Field(0.0, description="ignition after the start of the simulation, on the rail")
     thrust_scale: Scale = Field(1.0, description="multiplies the thrust curve (the burn time unchanged)")
+    burn_time_s: float | None = _added(
+        None, "reshapes the curve to this burn time keeping its total impulse: its times scaled to end at "
+        "burn_time_s, its thrusts by the inverse ratio (RocketPy's reshape_thrust_curve); dispersible (none: the "
+        "curve's own)", gt=0, le=MAX_BURN_TIME_S,
+    )
     nozzle_m: Position = Field(description="the nozzle exit, in the rocket's coordinates [m]")
     grain_outer_diameter_m: Diameter = Field(description="the propellant grain's outer diameter (burning outward); "
                                              "a designation estimates the grain from its casing")  # fmt: skip
@@ -256,6 +267,10 @@ class ParachuteConfig(_Strict):
     delay_s: Delay = Field(0.0, description="from the trigger to the start of opening")
     opening_time_s: Delay = Field(0.0, description="the drag area grows linearly over it")
     attach_m: Position
+    releases: str | None = _added(
+        None, "the name of another parachute cut away when this one starts opening (delay_s after its "
+        "trigger), its drag gone from then: a drogue released by the main (none: every canopy stays attached)",
+    )
 
 
 class AirbrakesConfig(_Strict):
@@ -292,7 +307,13 @@ class RocketConfig(_Strict):
     )
     dry_cg_m: Position
     dry_inertia_kgm2: list[Inertia] = Field(min_length=2, max_length=2, description="[axial, transverse]")
-    rear_lug_m: Position
+    rear_lug_m: Position = Field(description="the rear launch lug's aft end or rail button, in the rocket's coordinates "
+                                 "[m]; alone, the rocket leaves the rail when it passes the rail's top")
+    upper_lug_m: Position | None = _added(
+        None, "the upper (forward) of two rail buttons or lugs, in the rocket's coordinates [m]: the rocket leaves "
+        "the rail when it passes the rail's top, the pivot on the rear one until that leaves too not modelled (none: "
+        "one lug, rear_lug_m)",
+    )
     canopy_roll_damping: Damping = Field(-5.0, description="roll damping Clp under an open canopy, per ω·d/(2V)")
     motor: MotorConfig
     aero: AeroConfig = AeroConfig()
@@ -314,8 +335,22 @@ class RocketConfig(_Strict):
         names = [p.name for p in self.parachutes]
         if len(set(names)) != len(names):
             raise ValueError(f"parachute names must be unique, got {names}")
+        released = [p.releases for p in self.parachutes if p.releases is not None]
+        for i, chute in enumerate(self.parachutes):
+            if chute.releases is not None and (chute.releases not in names or chute.releases == chute.name):
+                raise ValueError(f"parachutes.{i}.releases: {chute.releases!r} is not another parachute of the "
+                                 f"rocket ({', '.join(names)})")  # fmt: skip
+            if released.count(chute.name) > 1:
+                raise ValueError(f"parachute {chute.name!r} is released by more than one parachute")
         if self.aero.model != "linear" and self.aero.tables == "buildup" and self.geometry is None:
             raise ValueError("aero.tables = 'buildup' needs the rocket's [rocket.geometry]")
+        return self
+
+    @model_validator(mode="after")
+    def _upper_lug_forward(self):
+        if self.upper_lug_m is not None and not self.from_nose(self.upper_lug_m) < self.from_nose(self.rear_lug_m):
+            raise ValueError(f"upper_lug_m ({self.upper_lug_m:g} m) must be forward of rear_lug_m "
+                             f"({self.rear_lug_m:g} m), nearer the nose")  # fmt: skip
         return self
 
 
@@ -331,7 +366,8 @@ class SiteConfig(_Strict):
 class LaunchConfig(_Strict):
     """The launch rail."""
 
-    rail_length_m: Length = Field(description="the rail's length; the rocket leaves when its rear lug passes the end")
+    rail_length_m: Length = Field(description="the rail's length; the rocket leaves when its upper lug (rocket.upper_lug_m, "
+                                  "else rear_lug_m) passes the end")
     elevation_deg: float = Field(gt=0, le=90, description="rail angle above the horizon")
     azimuth_deg: Direction = Field(description="clockwise from north")
 
@@ -476,6 +512,10 @@ class EnvironmentConfig(_Strict):
         None, description="the day's atmosphere and wind from a file; None: the standard atmosphere and "
                           "[environment.wind]")  # fmt: skip
     magnetic_field: MagneticFieldConfig = MagneticFieldConfig()
+    gravity: Literal["constant", "inverse_square"] = _added(
+        "constant", "'constant': standard gravity 9.80665 m/s² everywhere; 'inverse_square': 9.80665·(r0/(r0 + z))² "
+        "at the altitude z above mean sea level, r0 = 6356766 m (US Standard Atmosphere 1976)",
+    )
 
     @model_validator(mode="after")
     def _one_wind(self):

@@ -13,7 +13,9 @@ class Parachute:
     """cd_s_m2: drag area Cd·S of the open canopy [m²]; trigger_altitude_agl_m: it is triggered at the
     first moment after apogee when the altitude is at or below this value [m] (``inf``: at apogee);
     delay_s: from trigger to the start of opening [s]; opening_time_s: the drag area grows linearly
-    from 0 to Cd·S over this time [s]; attach_x_m: body-frame x of the attachment point [m]; name: a label such as "drogue" (static)."""
+    from 0 to Cd·S over this time [s]; attach_x_m: body-frame x of the attachment point [m]; name: a label such as "drogue" (static);
+    released_by: the index of the parachute that cuts this one away when it starts opening (static; None: stays
+    attached)."""
 
     cd_s_m2: jnp.ndarray
     trigger_altitude_agl_m: jnp.ndarray
@@ -21,6 +23,7 @@ class Parachute:
     opening_time_s: jnp.ndarray
     attach_x_m: jnp.ndarray
     name: str = static_field(default="parachute")
+    released_by: int | None = static_field(default=None)
 
 
 def open_fraction(chute: Parachute, trigger_time, t):

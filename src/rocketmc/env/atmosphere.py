@@ -63,6 +63,13 @@ def geopotential_altitude(z):
     return R_EARTH_GEOPOTENTIAL * z / (R_EARTH_GEOPOTENTIAL + z)
 
 
+def inverse_square_gravity(altitude_msl):
+    """Gravity [m/s²] at a geometric altitude above mean sea level [m]: G0·(r0/(r0 + z))², r0 =
+    ``R_EARTH_GEOPOTENTIAL``, the law the standard atmosphere's geopotential altitude rests on (US Standard
+    Atmosphere 1976, eq. 17)."""
+    return G0 * (R_EARTH_GEOPOTENTIAL / (R_EARTH_GEOPOTENTIAL + altitude_msl)) ** 2
+
+
 def isa(altitude_msl) -> AtmosphereState:
     """ISA state at a geometric altitude above mean sea level [m], clamped to [-2, 47] km."""
     return _isa_at_geopotential(geopotential_altitude(jnp.clip(altitude_msl, MIN_ALTITUDE_M, MAX_ALTITUDE_M)))

@@ -286,10 +286,11 @@ def sense(av: Avionics, state: AvionicsState, tick, t, r_n: Vec3, v_n: Vec3, q_n
     return _written(av, state, read, state.qbar)
 
 
-def specific_force_b(acceleration_n: Vec3, q_nb: Quat, omega_b: Vec3, omega_dot_b: Vec3, arm_b: Vec3) -> Vec3:
+def specific_force_b(acceleration_n: Vec3, q_nb: Quat, omega_b: Vec3, omega_dot_b: Vec3, arm_b: Vec3,
+                     gravity_mps2=G0) -> Vec3:  # fmt: skip
     """Specific force [m/s², body frame] at ``arm_b`` [m] from the CG: A(q)(a − g) + ω̇×r + ω×(ω×r), with the
-    CG's acceleration a [m/s², NED] and g = (0, 0, G0)."""
-    at_cg = q_nb.rotate_inverse(acceleration_n - Vec3(0.0, 0.0, G0))
+    CG's acceleration a [m/s², NED] and g = (0, 0, gravity_mps2)."""
+    at_cg = q_nb.rotate_inverse(acceleration_n - Vec3(0.0, 0.0, gravity_mps2))
     return at_cg + omega_dot_b.cross(arm_b) + omega_b.cross(omega_b.cross(arm_b))
 
 

@@ -31,6 +31,12 @@ def rail_start_n(p: FlightParams) -> Vec3:
     return p.launch.rail_direction_n * (mass_properties(p, 0.0).cg_x - p.rocket.motor.nozzle_x_m)
 
 
+def rail_travel_m(p: FlightParams):
+    """How far the rocket slides up the rail before it is free [m]: until its exit lug (``Rocket.exit_lug_x_m``)
+    passes the rail's top, the nozzle exit starting at its foot."""
+    return p.launch.rail_length_m - (p.rocket.exit_lug_x_m - p.rocket.motor.nozzle_x_m)
+
+
 def update_events(
     p: FlightParams, start_n: Vec3, ev: Events, t0, h, b0: RigidBodyState, b1: RigidBodyState, diag: Diagnostics,
     sensed=None,
@@ -46,9 +52,9 @@ def update_events(
     speed0, speed1 = b0.v_n.norm(), b1.v_n.norm()
     alt0, alt1 = -b0.r_n.z, -b1.r_n.z
 
-    # Rail exit: the rear lug passes the top of the rail (the nozzle started at its foot); the CG
+    # Rail exit: the exit lug passes the top of the rail (the nozzle started at its foot); the CG
     # shift while on the rail (< 1 cm for Lynx) is neglected.
-    travel_to_exit = p.launch.rail_length_m - (p.rocket.rear_lug_x_m - motor.nozzle_x_m)
+    travel_to_exit = rail_travel_m(p)
     g0 = travel_to_exit - (b0.r_n - start_n).dot(rail)
     g1 = travel_to_exit - (b1.r_n - start_n).dot(rail)
     hit = jnp.isinf(ev.rail_exit_time) & (g1 <= 0.0)

@@ -232,8 +232,9 @@ def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, firs
     zero = Vec3.zeros(start.t)
     position = p.avionics.accelerometer.position_b
     arm_b = Vec3(position[0] - cg_x, position[1], position[2])
+    gravity = p.environment.gravity_mps2(p.environment.site_altitude_m - body.r_n.z)
     force = specific_force_b(tree_where(landed, zero, acceleration_n), body.q_nb, body.omega_b,
-                             tree_where(landed, zero, omega_dot_b), arm_b)  # fmt: skip
+                             tree_where(landed, zero, omega_dot_b), arm_b, gravity)  # fmt: skip
     qbar = jnp.where(landed, 0.0, qbar)
     avionics = sense_acceleration(_avionics_at(p, start.t), state.avionics, start.tick, force, qbar, sensing,
                                   noise.avionics)  # fmt: skip

@@ -12,7 +12,6 @@ from ..aero import AirData, aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis
-from ..env import G0
 from ..math import Quat, Vec3
 from ..pytree import tree_where
 from .params import FlightParams
@@ -66,6 +65,10 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
     stiffness = jnp.zeros_like(t)
     for chute, trigger_time in zip(rocket.parachutes, events.chute_trigger_times):
         fraction = open_fraction(chute, trigger_time, t)
+        if chute.released_by is not None:  # cut away once the canopy that releases it starts opening
+            releaser = rocket.parachutes[chute.released_by]
+            cut_time = events.chute_trigger_times[chute.released_by] + releaser.delay_s
+            fraction = jnp.where(t >= cut_time, 0.0, fraction)
         arm_b = Vec3(chute.attach_x_m - mass.cg_x, 0.0, 0.0)
         v_air_n = body.v_n + q_nb.rotate(omega_b.cross(arm_b)) - wind_n
         drag_n = parachute_drag_n(chute, fraction, v_air_n, atmosphere.density)
@@ -91,7 +94,8 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind."""
     f = loads(t, body, p, deflections, gust_n, events)
     force_b = f.aero_force_b + Vec3(f.thrust_n, 0.0, 0.0)
-    free = rigid_body_derivatives(body, f.mass, force_b, f.chute_force_n, f.moment_b, G0)
+    gravity = p.environment.gravity_mps2(p.environment.site_altitude_m - body.r_n.z)
+    free = rigid_body_derivatives(body, f.mass, force_b, f.chute_force_n, f.moment_b, gravity)
 
     # On the rail: motion along it only, no rotation, no sliding back down before liftoff.
     rail = p.launch.rail_direction_n

@@ -11,9 +11,9 @@ from ..dynamics import Motor, Parachute
 from ..gnc.control import GncParams
 from ..sensors.avionics import Avionics
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
-from ..env.atmosphere import AtmosphereProfile, AtmosphereState, air
+from ..env.atmosphere import G0, AtmosphereProfile, AtmosphereState, air, inverse_square_gravity
 from ..math import Quat, Vec3
-from ..pytree import pytree_dataclass
+from ..pytree import pytree_dataclass, static_field
 from .faults import Faults
 
 
@@ -23,7 +23,8 @@ class Rocket:
 
     dry_mass_kg: mass without propellant [kg]; dry_cg_x_m: its CG on the body x axis from the
     reference point [m]; dry_ixx_kgm2, dry_iyy_kgm2: its inertia about that CG [kg·m²];
-    rear_lug_x_m: body-frame x of the rear launch lug [m]; aero: the aerodynamic model, linear or interpolated
+    exit_lug_x_m: body-frame x of the launch lug (or rail button) whose passing the rail's top frees the rocket: the
+    upper of two, else the only one [m]; aero: the aerodynamic model, linear or interpolated
     from tables (``aero.model``); canopy_cl_p: roll damping under canopy;
     airbrake_time_s, airbrake_delta_ca: the airbrakes' extra axial-force coefficient against time since
     ignition [s] (linear in between, 0 outside), or None without airbrakes.
@@ -33,7 +34,7 @@ class Rocket:
     dry_cg_x_m: jnp.ndarray
     dry_ixx_kgm2: jnp.ndarray
     dry_iyy_kgm2: jnp.ndarray
-    rear_lug_x_m: jnp.ndarray
+    exit_lug_x_m: jnp.ndarray
     motor: Motor
     aero: LinearAero | TableAero
     parachutes: tuple[Parachute, ...]
@@ -63,16 +64,22 @@ class Launch:
 class Environment:
     """site_altitude_m: pad altitude above mean sea level [m]; wind: the mean wind; turbulence:
     Dryden gusts added to it (None: no turbulence, and no cost); atmosphere: the day's (None: the ISA, and
-    no cost)."""
+    no cost); gravity: "constant" (G0 everywhere) or "inverse_square" (falling with altitude, static)."""
 
     site_altitude_m: jnp.ndarray
     wind: WindLayers | WindProfile | PowerLawWind
     turbulence: Turbulence | None = None
     atmosphere: AtmosphereProfile | None = None
+    gravity: str = static_field(default="constant")
 
     def air(self, altitude_msl) -> AtmosphereState:
         """The air at a geometric altitude above mean sea level [m]."""
         return air(self.atmosphere, altitude_msl)
+
+    def gravity_mps2(self, altitude_msl):
+        """Gravity [m/s², down] at a geometric altitude above mean sea level [m]: G0, or with
+        ``gravity = "inverse_square"`` G0·(r0/(r0 + z))² (``env.atmosphere.inverse_square_gravity``)."""
+        return inverse_square_gravity(altitude_msl) if self.gravity == "inverse_square" else G0
 
 
 @pytree_dataclass
