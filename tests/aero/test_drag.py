@@ -138,21 +138,22 @@ def test_nose_pressure_drag_is_continuous_and_small_subsonic(kind):
 
 
 def test_fin_pressure_drag_profiles():
-    unswept = FinSet(3, 0.2, 0.2, 0.1, 0.0, 1.0, thickness_m=0.005)
+    def fins(profile, sweep_m=0.0):
+        return FinSet(3, 0.2, 0.2, 0.1, sweep_m, 1.0, thickness_m=0.005, profile=profile)
+
     # Square edges at rest: stagnation 0.85 on the leading edge + base 0.12 on the trailing edge.
-    assert fin_pressure_drag_coefficient(unswept, 0.0, "square") == pytest.approx(0.97, rel=1e-12)
+    assert fin_pressure_drag_coefficient(fins("square"), 0.0) == pytest.approx(0.97, rel=1e-12)
     # Rounded at rest: no leading-edge drag, half the base drag; airfoil: nothing.
-    assert fin_pressure_drag_coefficient(unswept, 0.0, "rounded") == pytest.approx(0.06, rel=1e-12)
-    assert fin_pressure_drag_coefficient(unswept, 0.0, "airfoil") == pytest.approx(0.0, abs=1e-12)
+    assert fin_pressure_drag_coefficient(fins("rounded"), 0.0) == pytest.approx(0.06, rel=1e-12)
+    assert fin_pressure_drag_coefficient(fins("airfoil"), 0.0) == pytest.approx(0.0, abs=1e-12)
     # Rounded leading edge (1 - M^2)^-0.417 - 1 and the cos^2 sweep factor (45° halves it).
-    swept = dataclasses.replace(unswept, sweep_m=0.1)
     leading = (1 - 0.7**2) ** -0.417 - 1
-    assert fin_pressure_drag_coefficient(swept, 0.7, "airfoil") == pytest.approx(0.5 * leading, rel=1e-12)
+    assert fin_pressure_drag_coefficient(fins("airfoil", 0.1), 0.7) == pytest.approx(0.5 * leading, rel=1e-12)
     mach = np.linspace(0.0, 2.0, 2001)
     for profile in ("rounded", "square", "airfoil"):
-        assert np.max(np.abs(np.diff(fin_pressure_drag_coefficient(swept, mach, profile)))) < 5e-3
+        assert np.max(np.abs(np.diff(fin_pressure_drag_coefficient(fins(profile, 0.1), mach)))) < 5e-3
     with pytest.raises(ValueError, match="profile"):
-        fin_pressure_drag_coefficient(unswept, 0.5, "wedge")
+        fins("wedge")
 
 
 # ---- trends and bookkeeping -------------------------------------------------------------------
@@ -172,7 +173,8 @@ def test_power_on_reduces_base_drag():
 
 def test_altitude_acts_through_reynolds_number():
     mach = 0.3
-    low, high = (drag_breakdown(LYNX_AS_FLOWN, mach, h, surface_roughness_m=0.0) for h in (0.0, 3000.0))
+    smooth = dataclasses.replace(LYNX_AS_FLOWN, surface_roughness_m=0.0)
+    low, high = (drag_breakdown(smooth, mach, h) for h in (0.0, 3000.0))
     # Turbulent regime: thinner air -> lower Re -> higher Cf; only the friction terms change.
     assert high["friction_body"] > low["friction_body"]
     assert high["friction_fins"] / low["friction_fins"] == pytest.approx(
@@ -215,10 +217,10 @@ def test_boat_tail_takes_over_base_drag():
     mid = dataclasses.replace(body, boat_tail=BoatTail(0.12, 0.09, body.length_m - 0.12))  # l/Δd = 2
     plain, s, g, m = (drag_breakdown(x, 0.5, 0.0) for x in (body, steep, gentle, mid))
     # Steep (ratio < 1): the boat-tail carries the base drag of the area it removes, total base unchanged.
-    assert s["base"] + s["boat_tail_pressure"] == pytest.approx(plain["base"], rel=1e-12)
+    assert s["base"] + s["transition_pressure"] == pytest.approx(plain["base"], rel=1e-12)
     assert s["base"] == pytest.approx(plain["base"] * (0.09 / d) ** 2, rel=1e-12)
-    assert g["boat_tail_pressure"] == 0.0 and g["total"] < plain["total"]  # gentle (ratio > 3): none
-    assert m["boat_tail_pressure"] == pytest.approx(0.5 * s["boat_tail_pressure"], rel=1e-12)  # (3 - 2)/2
+    assert g["transition_pressure"] == 0.0 and g["total"] < plain["total"]  # gentle (ratio > 3): none
+    assert m["transition_pressure"] == pytest.approx(0.5 * s["transition_pressure"], rel=1e-12)  # (3 - 2)/2
     with pytest.raises(ValueError, match="boat-tail"):
         zero_lift_axial_coefficient(dataclasses.replace(body, boat_tail=BoatTail(0.1, 0.09, 1.0)), 0.5, 0.0)
 
