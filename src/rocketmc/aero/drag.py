@@ -38,9 +38,12 @@ and FinSetCalc). Every term is a drag coefficient referenced to ``geometry.refer
   150 µm, regular paint 60 µm, smooth paint 20 µm, polished 2 µm; ``OPENROCKET_FINISHES_M``).
 - Launch lugs (parasitic drag, Niskanen 2009 §3.4.5 after Hoerner, Fluid-Dynamic Drag (1965) ch. 3):
   a tube in axial flow, max(1.3 − l/d, 1) times the stagnation drag on its frontal area
-  π(r_o² − r_i² max(1 − l/d, 0)) (a long lug's bore passes air, a short one's does not).
+  π(r_o² − r_i² max(1 − l/d, 0)) (a short lug's bore passes its air; a long one's, slowed by the
+  friction inside, counts as blocked).
 - Rail buttons: a cylinder in crossflow, the circular cylinder's drag against Mach (Gowen & Perkins,
-  NACA TN 2960 (1953), fig. 7: 1.2 at low speed) on the button's side profile less its waist's notch,
+  NACA TN 2960 (1953), fig. 7: 1.2 at low speed) times the finite cylinder's ratio for its free end
+  (White, Fluid Mechanics, table 7.2: 0.68 at l/d = 2, the button and its mirror image in the body)
+  on the button's side profile less its waist's notch,
   at the mean dynamic pressure over its height inside the turbulent boundary layer of the body
   (u/U = (y/δ)^(1/7), δ = 0.37 x Re_x^−0.2 at its distance x from the nose tip; Schlichting, Boundary-
   Layer Theory, ch. XXI), as OpenRocket's RailButtonCalc reduces it.
@@ -73,6 +76,10 @@ OPENROCKET_FINISHES_M = {"rough": 500e-6, "unfinished": 150e-6, "normal": 60e-6,
 # 2960, fig. 7, as transcribed in OpenRocket's RailButtonCalc); held at the last value beyond.
 _CYLINDER_MACH = (0.0, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 1.0, 1.6, 2.0, 2.8)
 _CYLINDER_CD = (1.2, 1.22, 1.25, 1.3, 1.4, 1.5, 1.6, 2.1, 1.5, 1.45, 1.33)
+# A finite cylinder's drag over the infinite one's vs its length over diameter (White, Fluid Mechanics, table 7.2,
+# after Hoerner); a button standing on the body is half of a cylinder twice its height (the wall a mirror).
+_FINITE_CYLINDER_LD = (1.0, 2.0, 5.0, 10.0, 20.0, 40.0)
+_FINITE_CYLINDER_RATIO = (0.64, 0.68, 0.74, 0.82, 0.91, 0.98)
 
 # Pressure drag of noses of fineness ratio 3 vs Mach (NASA TR-R-100, "Collection of zero-lift drag
 # data on bodies of revolution from free-flight investigations", p. 16, as tabulated in OpenRocket's
@@ -296,8 +303,9 @@ def lug_drag_coefficient(geometry: RocketGeometry, mach) -> np.ndarray:
 
 
 def rail_button_drag_coefficient(geometry: RocketGeometry, mach, reynolds_per_m) -> np.ndarray:
-    """Pressure drag [-] (ref S) of the rail buttons: the cylinder's Cd(M) on each button's frontal area,
-    at the mean dynamic pressure of the 1/7-power turbulent boundary layer over its height.
+    """Pressure drag [-] (ref S) of the rail buttons: the cylinder's Cd(M), times the finite cylinder's ratio
+    for twice the button's height, on each button's frontal area, at the mean dynamic pressure of the
+    1/7-power turbulent boundary layer over its height.
 
     reynolds_per_m: V/ν of the flight [1/m], broadcast with ``mach``."""
     mach = np.asarray(mach, dtype=float)
@@ -308,7 +316,8 @@ def rail_button_drag_coefficient(geometry: RocketGeometry, mach, reynolds_per_m)
         thickness = 0.37 * x / np.maximum(reynolds_per_m * x, 1.0) ** 0.2
         inside = np.minimum(button.height_m, thickness)  # the part of the button inside the layer [m]
         q_ratio = (7 / 9 * inside * (inside / thickness) ** (2 / 7) + (button.height_m - inside)) / button.height_m
-        total = total + cylinder * q_ratio * button.frontal_area_m2
+        finite = np.interp(2 * button.height_m / button.outer_diameter_m, _FINITE_CYLINDER_LD, _FINITE_CYLINDER_RATIO)
+        total = total + finite * cylinder * q_ratio * button.frontal_area_m2
     return total / geometry.reference_area_m2
 
 

@@ -590,7 +590,7 @@ def _weather(config: CampaignConfig, base_dir: Path) -> Weather | None:
     return weather
 
 
-def _rocket_geometry(rocket: RocketConfig) -> RocketGeometry:
+def rocket_geometry(rocket: RocketConfig) -> RocketGeometry:
     """The build-up's ``RocketGeometry`` of ``rocket.geometry``, its positions from the nose tip [m]."""
     g, from_nose = rocket.geometry, rocket.from_nose
 
@@ -616,7 +616,7 @@ def _rocket_geometry(rocket: RocketConfig) -> RocketGeometry:
 
 def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
     aero = rocket.aero
-    geometry = None if rocket.geometry is None else _rocket_geometry(rocket)
+    geometry = None if rocket.geometry is None else rocket_geometry(rocket)
     try:
         if aero.tables == "buildup":
             tables = build_up_tables(geometry, rocket.from_nose(rocket.reference_point_m))
@@ -646,7 +646,7 @@ def _power_on_table(rocket: RocketConfig) -> Table | None:
     if aero.cd_power_on is not None:
         mach, increment = aero.cd_mach, np.subtract(aero.cd_power_on, aero.cd)
     elif aero.tables == "buildup" and aero.cd is None:
-        geometry = _rocket_geometry(rocket)
+        geometry = rocket_geometry(rocket)
         mach, increment = power_on_axial_increment(geometry, rocket.motor.grain_outer_diameter_m)
     else:
         return None

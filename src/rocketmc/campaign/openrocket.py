@@ -355,6 +355,9 @@ class _Reader:
         if tag in ASSEMBLIES:
             return None
         self.parts += 1
+        if element.find("overridecd") is not None:
+            self.warnings.append(f"component {name!r}: its drag override (Cd {element.findtext('overridecd')}) is not "
+                                 "flown: rocketmc computes the drag of every component from its shape")  # fmt: skip
         if element.find("motormount") is not None:
             self.mounts.append((name, element.find("motormount"), top_m, length_m))
         if tag in BODY_KINDS:
