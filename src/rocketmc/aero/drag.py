@@ -62,7 +62,7 @@ import math
 import numpy as np
 
 from ..env.atmosphere import isa
-from .geometry import FIN_PROFILES, FinSet, RocketGeometry, nose_radius_m
+from .geometry import FinSet, RocketGeometry, nose_radius_m
 
 GAMMA_AIR = 1.4  # ratio of specific heats [-]
 SUTHERLAND_BETA = 1.458e-6  # Sutherland's law constant [kg/(m·s·K^0.5)] (USSA 1976)
