@@ -5,7 +5,7 @@
 Imports every .ork in FOLDER (``rocketmc import``: the first simulation's motor, site, rail and wind, or each
 simulation with stored flight data with ``--all-simulations``), loads the campaign, flies its nominal flight (as
 ``rocketmc fly`` does) and prints, per design and simulation, OpenRocket's stored apogee, maximum speed, time to
-apogee and launch-rod speed beside rocketmc's, and the mass and CG at t = 0 (motor included) beside the stored ones.
+apogee, launch-rod speed and maximum Mach number beside rocketmc's, and the mass and CG at t = 0 (motor included) beside the stored ones.
 Designs rocketmc refuses are listed with the refusal. The campaigns are written to a temporary folder.
 """
 
@@ -26,6 +26,7 @@ from rocketmc.campaign.openrocket_campaign import import_openrocket
 
 COMPARED = (("apogee [m]", "maxaltitude", "apogee"), ("max speed [m/s]", "maxvelocity", "max_speed"),
             ("time to apogee [s]", "timetoapogee", "apogee_time"), ("rod speed [m/s]", "launchrodvelocity", "rod_speed"),
+            ("max Mach", "maxmach", "max_mach"),
             ("mass t=0 [kg]", "Mass", "mass"), ("CG t=0 [m]", "CG location", "cg"))  # fmt: skip
 """(label, OpenRocket's flightdata attribute or t = 0 column, rocketmc's key)."""
 
@@ -39,6 +40,7 @@ def fly(design_path: Path, simulation: int, folder: Path) -> dict:
     series, summary = record.series, record.summary
     ours = {"apogee": summary["apogee_agl_m"], "max_speed": float(np.max(series["speed"])),
             "apogee_time": summary["apogee_time_s"], "rod_speed": summary["rail_exit_speed_mps"],
+            "max_mach": float(np.max(series["mach"])),
             "mass": float(series["mass"].iloc[0]), "cg": float(series["cg"].iloc[0])}  # fmt: skip
     theirs = {key: sim.summary.get(attribute, sim.at_liftoff(attribute)) for _, attribute, key in COMPARED}
     return {"design": design_path.stem, "simulation": f"{simulation} {sim.name} ({result.lines[0].split('motor ')[-1]})",

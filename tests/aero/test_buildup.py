@@ -16,7 +16,7 @@ from rocketmc.aero.buildup import (
     slender_body_factors,
 )
 from rocketmc.aero.datcom import DATCOM_COEFFS, LYNX_DATCOM, load_datcom_mat
-from rocketmc.aero.geometry import LYNX_AS_FLOWN, LYNX_CANARDS
+from rocketmc.aero.geometry import LYNX_AS_FLOWN, LYNX_CANARDS, FinSet, Nose, RocketGeometry, Transition
 from rocketmc.aero.tables import PANEL_AXES, PANEL_COEFFS
 
 X_DATCOM = 1.49  # DATCOM moment reference of the as-flown table [m from the nose tip]
@@ -168,3 +168,30 @@ def test_canard_rocket_linear_and_thesis_gap():
     # Closed forms of the geometry (measured 15.45304 and -12.68010): the bounds are the values' last digit.
     assert cn == pytest.approx(15.453, abs=1e-3)
     assert -cn * (cp - X_THESIS) / D == pytest.approx(-12.680, abs=1e-3)
+
+
+@pytest.mark.parametrize("fore_d, aft_d", [(0.1, 0.14), (0.1, 0.07)])  # widening, narrowing
+def test_transition_slender_body_lift_at_its_centroid(fore_d, aft_d):
+    """Slender-body theory (Barrowman 1967; Niskanen 2009 §3.2): a conical section gives CNα = 2ΔA/S at the
+    centroid of dA, ∫x dA/ΔA = x₀ + 2πL/Δr [(r₂³ − r₁³)/3 − r₁(r₂² − r₁²)/2]/ΔA for r linear in x. rel 1e-6: the
+    build-up integrates the area over 2000 intervals (trapezoids, second order: ~1e-7 here)."""
+    body = RocketGeometry(0.1, 1.5, Nose("ogive", 0.3))
+    x0, length, r1, r2 = 1.0, 0.2, fore_d / 2, aft_d / 2
+    geometry = dataclasses.replace(body, transitions=(Transition(x0, length, fore_d, aft_d),))
+    (section,) = [c for c in normal_force_components(geometry, 0.3) if c.name.startswith("transition")]
+    d_area = math.pi * (r2**2 - r1**2)
+    centroid = x0 + 2 * math.pi * length / (r2 - r1) * ((r2**3 - r1**3) / 3 - r1 * (r2**2 - r1**2) / 2) / d_area
+    assert float(section.cn_alpha) == pytest.approx(2 * d_area / body.reference_area_m2, rel=1e-6)
+    assert section.cp_m == pytest.approx(centroid, rel=1e-6)
+
+
+def test_fins_on_a_narrower_section_take_its_radius():
+    """Fins on a section narrower than the reference body: their interference ratio τ = r/(r + s) uses the local
+    radius (NACA 1307's r is the body's at the fins), so they carry less body carry-over than on the full body.
+    Exact: the same solver at the local τ."""
+    fins = FinSet(3, 0.1, 0.05, 0.05, 0.03, 1.35, thickness_m=0.003)
+    full = RocketGeometry(0.1, 1.5, Nose("ogive", 0.3), fins=(fins,))
+    narrow = dataclasses.replace(full, transitions=(Transition(1.0, 0.1, 0.1, 0.06),))
+    (on_full,), (on_narrow,) = ([c for c in normal_force_components(g, 0.3) if c.name == "fins1"] for g in (full, narrow))
+    ratio = slender_body_factors(3, round(0.03 / 0.08, 12)).lift / slender_body_factors(3, round(0.05 / 0.1, 12)).lift
+    assert float(on_narrow.cn_alpha / on_full.cn_alpha) == pytest.approx(ratio, rel=1e-12)

@@ -21,7 +21,19 @@ from rocketmc.aero.drag import (
     stagnation_drag_coefficient,
     zero_lift_axial_coefficient,
 )
-from rocketmc.aero.geometry import LYNX_AS_FLOWN, LYNX_CANARDS, NOSE_KINDS, BoatTail, FinSet
+from rocketmc.aero.geometry import (
+    LYNX_AS_FLOWN,
+    LYNX_CANARDS,
+    NOSE_KINDS,
+    BoatTail,
+    FinSet,
+    LaunchLug,
+    Nose,
+    RailButton,
+    RocketGeometry,
+    Transition,
+)
+from rocketmc.env.atmosphere import isa
 
 DATCOM_ALTITUDE_M = 109.0  # first altitude of the DATCOM grid
 
@@ -138,21 +150,22 @@ def test_nose_pressure_drag_is_continuous_and_small_subsonic(kind):
 
 
 def test_fin_pressure_drag_profiles():
-    unswept = FinSet(3, 0.2, 0.2, 0.1, 0.0, 1.0, thickness_m=0.005)
+    def fins(profile, sweep_m=0.0):
+        return FinSet(3, 0.2, 0.2, 0.1, sweep_m, 1.0, thickness_m=0.005, profile=profile)
+
     # Square edges at rest: stagnation 0.85 on the leading edge + base 0.12 on the trailing edge.
-    assert fin_pressure_drag_coefficient(unswept, 0.0, "square") == pytest.approx(0.97, rel=1e-12)
+    assert fin_pressure_drag_coefficient(fins("square"), 0.0) == pytest.approx(0.97, rel=1e-12)
     # Rounded at rest: no leading-edge drag, half the base drag; airfoil: nothing.
-    assert fin_pressure_drag_coefficient(unswept, 0.0, "rounded") == pytest.approx(0.06, rel=1e-12)
-    assert fin_pressure_drag_coefficient(unswept, 0.0, "airfoil") == pytest.approx(0.0, abs=1e-12)
+    assert fin_pressure_drag_coefficient(fins("rounded"), 0.0) == pytest.approx(0.06, rel=1e-12)
+    assert fin_pressure_drag_coefficient(fins("airfoil"), 0.0) == pytest.approx(0.0, abs=1e-12)
     # Rounded leading edge (1 - M^2)^-0.417 - 1 and the cos^2 sweep factor (45° halves it).
-    swept = dataclasses.replace(unswept, sweep_m=0.1)
     leading = (1 - 0.7**2) ** -0.417 - 1
-    assert fin_pressure_drag_coefficient(swept, 0.7, "airfoil") == pytest.approx(0.5 * leading, rel=1e-12)
+    assert fin_pressure_drag_coefficient(fins("airfoil", 0.1), 0.7) == pytest.approx(0.5 * leading, rel=1e-12)
     mach = np.linspace(0.0, 2.0, 2001)
     for profile in ("rounded", "square", "airfoil"):
-        assert np.max(np.abs(np.diff(fin_pressure_drag_coefficient(swept, mach, profile)))) < 5e-3
+        assert np.max(np.abs(np.diff(fin_pressure_drag_coefficient(fins(profile, 0.1), mach)))) < 5e-3
     with pytest.raises(ValueError, match="profile"):
-        fin_pressure_drag_coefficient(unswept, 0.5, "wedge")
+        fins("wedge")
 
 
 # ---- trends and bookkeeping -------------------------------------------------------------------
@@ -172,7 +185,8 @@ def test_power_on_reduces_base_drag():
 
 def test_altitude_acts_through_reynolds_number():
     mach = 0.3
-    low, high = (drag_breakdown(LYNX_AS_FLOWN, mach, h, surface_roughness_m=0.0) for h in (0.0, 3000.0))
+    smooth = dataclasses.replace(LYNX_AS_FLOWN, surface_roughness_m=0.0)
+    low, high = (drag_breakdown(smooth, mach, h) for h in (0.0, 3000.0))
     # Turbulent regime: thinner air -> lower Re -> higher Cf; only the friction terms change.
     assert high["friction_body"] > low["friction_body"]
     assert high["friction_fins"] / low["friction_fins"] == pytest.approx(
@@ -215,10 +229,10 @@ def test_boat_tail_takes_over_base_drag():
     mid = dataclasses.replace(body, boat_tail=BoatTail(0.12, 0.09, body.length_m - 0.12))  # l/Δd = 2
     plain, s, g, m = (drag_breakdown(x, 0.5, 0.0) for x in (body, steep, gentle, mid))
     # Steep (ratio < 1): the boat-tail carries the base drag of the area it removes, total base unchanged.
-    assert s["base"] + s["boat_tail_pressure"] == pytest.approx(plain["base"], rel=1e-12)
+    assert s["base"] + s["transition_pressure"] == pytest.approx(plain["base"], rel=1e-12)
     assert s["base"] == pytest.approx(plain["base"] * (0.09 / d) ** 2, rel=1e-12)
-    assert g["boat_tail_pressure"] == 0.0 and g["total"] < plain["total"]  # gentle (ratio > 3): none
-    assert m["boat_tail_pressure"] == pytest.approx(0.5 * s["boat_tail_pressure"], rel=1e-12)  # (3 - 2)/2
+    assert g["transition_pressure"] == 0.0 and g["total"] < plain["total"]  # gentle (ratio > 3): none
+    assert m["transition_pressure"] == pytest.approx(0.5 * s["transition_pressure"], rel=1e-12)  # (3 - 2)/2
     with pytest.raises(ValueError, match="boat-tail"):
         zero_lift_axial_coefficient(dataclasses.replace(body, boat_tail=BoatTail(0.1, 0.09, 1.0)), 0.5, 0.0)
 
@@ -267,3 +281,77 @@ def test_lynx_canards_against_thesis(datcom_ca0):
     increment = ours[:2] - zero_lift_axial_coefficient(LYNX_AS_FLOWN, thesis_mach[:2], DATCOM_ALTITUDE_M)
     thesis_increment = thesis_ca0[:2] - np.interp(thesis_mach[:2], machs, datcom)
     assert increment == pytest.approx(thesis_increment, abs=0.012)
+
+
+# ---- surface finish, transitions, lugs and rail buttons ----------------------------------------------
+
+BODY = RocketGeometry(0.1, 1.5, Nose("ogive", 0.3))
+"""A finless body for the closed forms below: 10 cm across, 1.5 m long."""
+
+
+def test_rough_finish_gives_the_roughness_limited_friction():
+    """Niskanen 2009 §3.4.1: above its critical Reynolds number a surface of roughness Rs has Cf = 0.032 (Rs/L)^0.2,
+    times 1 − 0.1 M² subsonic; the body's is Cf (1 + d/(2L)) A_wet/S. A fin set's own finish sets its Cf alone.
+    rel 1e-12: the same closed form, rounding only."""
+    rough = dataclasses.replace(BODY, surface_roughness_m=500e-6)
+    cf = 0.032 * (500e-6 / 1.5) ** 0.2 * (1 - 0.1 * 0.3**2)
+    wetted = nose_wetted_area_m2("ogive", 0.3, 0.05) + 2 * math.pi * 0.05 * 1.2
+    expected = cf * (1 + 0.05 / 1.5) * wetted / BODY.reference_area_m2
+    assert drag_breakdown(rough, 0.3, 0.0)["friction_body"] == pytest.approx(expected, rel=1e-12)
+    fins = FinSet(3, 0.1, 0.05, 0.05, 0.03, 1.35, thickness_m=0.003)
+    smooth_fins = dataclasses.replace(rough, fins=(fins,))
+    rough_fins = dataclasses.replace(BODY, fins=(dataclasses.replace(fins, surface_roughness_m=500e-6),))
+    assert drag_breakdown(rough_fins, 0.3, 0.0)["friction_fins"] == pytest.approx(
+        drag_breakdown(smooth_fins, 0.3, 0.0)["friction_fins"], rel=1e-12)
+    assert drag_breakdown(rough_fins, 0.3, 0.0)["friction_body"] < expected  # the body keeps its 20 µm
+
+
+def test_transitions_widening_narrowing_and_steps():
+    """A widening cone at rest: 0.8 sin²ε on the ring it adds (the cone's drag, OpenRocket appendix B); a step up:
+    the stagnation drag 0.85 on its ring, a step down the base drag 0.12 on its ring; a cylinder section of the
+    body's own diameter changes nothing. rel 1e-12: closed forms, rounding only (the wetted area is integrated)."""
+    s_ref = BODY.reference_area_m2
+    flare = dataclasses.replace(BODY, transitions=(Transition(1.0, 0.2, 0.1, 0.14),))
+    sin_e = 0.02 / math.hypot(0.02, 0.2)
+    ring = math.pi / 4 * (0.14**2 - 0.1**2)
+    got = drag_breakdown(flare, 0.0, 0.0)
+    assert got["transition_pressure"] == pytest.approx(0.8 * sin_e**2 * ring / s_ref, rel=1e-9)
+    assert got["base"] == pytest.approx(0.12 * 0.14**2 / 0.1**2, rel=1e-12)  # the base is the wider end
+    step = dataclasses.replace(BODY, transitions=(Transition(1.0, 0.5, 0.12, 0.12),))
+    assert drag_breakdown(step, 0.0, 0.0)["transition_pressure"] == pytest.approx(
+        0.85 * math.pi / 4 * (0.12**2 - 0.1**2) / s_ref, rel=1e-12)
+    notch = dataclasses.replace(BODY, transitions=(Transition(1.0, 0.5, 0.08, 0.08),))
+    assert drag_breakdown(notch, 0.0, 0.0)["transition_pressure"] == pytest.approx(
+        0.12 * math.pi / 4 * (0.1**2 - 0.08**2) / s_ref, rel=1e-12)
+    same = dataclasses.replace(BODY, transitions=(Transition(1.0, 0.5, 0.1, 0.1),))
+    assert drag_breakdown(same, 0.4, 0.0)["total"] == pytest.approx(drag_breakdown(BODY, 0.4, 0.0)["total"], rel=1e-12)
+
+
+def test_launch_lug_is_a_tube_in_axial_flow():
+    """Niskanen 2009 §3.4.5: max(1.3 − l/d, 1) C_stag on π(r_o² − r_i² max(1 − l/d, 0)); C_stag = 0.85 at rest.
+    rel 1e-12: closed form."""
+    long_lug = dataclasses.replace(BODY, launch_lugs=(LaunchLug(0.5, 0.05, 0.01, 0.008),))  # l/d = 5: bore blocked
+    assert drag_breakdown(long_lug, 0.0, 0.0)["launch_lugs"] == pytest.approx(
+        0.85 * math.pi / 4 * 0.01**2 / BODY.reference_area_m2, rel=1e-12)
+    short = dataclasses.replace(BODY, launch_lugs=(LaunchLug(0.5, 0.002, 0.01, 0.008),))  # l/d = 0.2
+    frontal = math.pi / 4 * (0.01**2 - 0.008**2 * 0.8)
+    assert drag_breakdown(short, 0.0, 0.0)["launch_lugs"] == pytest.approx(
+        1.1 * 0.85 * frontal / BODY.reference_area_m2, rel=1e-12)
+
+
+def test_rail_button_in_the_boundary_layer():
+    """A button inside the body's turbulent boundary layer (δ = 0.37 x Re_x^−0.2, u/U = (y/δ)^(1/7): mean q over its
+    height 7/9 (h/δ)^(2/7)) with the cylinder's Cd 1.2 (Gowen & Perkins, M → 0 by linear interpolation to M 0.1:
+    1.21) and White's finite-cylinder ratio 0.68 at l/d = 2 (the button, 1 cm high and across, and its mirror
+    image). rel 1e-9: closed form with the ISA's viscosity."""
+    button = RailButton(1.0, 0.01, 0.01, 0.01, 0.0)
+    geometry = dataclasses.replace(BODY, rail_buttons=(button,))
+    mach = 0.1
+    air = isa(0.0)
+    re_x = mach * float(air.speed_of_sound) * float(air.density) / float(dynamic_viscosity(air.temperature))
+    delta = 0.37 / re_x**0.2
+    assert 0.01 < delta  # inside the layer, as the closed form needs
+    expected = 0.68 * 1.21 * 7 / 9 * (0.01 / delta) ** (2 / 7) * 1e-4 / BODY.reference_area_m2
+    assert drag_breakdown(geometry, mach, 0.0)["rail_buttons"] == pytest.approx(expected, rel=1e-9)
+    # The waist's notch is left out of its frontal area.
+    assert RailButton(1.0, 0.01, 0.01, 0.006, 0.004).frontal_area_m2 == pytest.approx(1e-4 - 0.004 * 0.004, rel=1e-12)

@@ -294,7 +294,6 @@ def test_a_motor_of_the_library_by_designation(tmp_path):
     ("cluster", "'Motor tube' (innertube): a motor cluster"),
     ("second stage", "'Booster' (stage): a second stage"),
     ("tube fins", "'Tubes' (tubefinset)"),
-    ("body step", "'Wide' (bodytube): the body's diameter changes"),
     ("no simulation", "no simulation and its motor 'X1' is not in rocketmc's library"),
     ("corrupt zip", "a corrupt zip"),
     ("no rocket.ork", "a zip without rocket.ork"),
@@ -309,8 +308,6 @@ def test_each_refusal_is_one_line_naming_the_component_and_writes_nothing(tmp_pa
         "second stage": lambda: design_xml(extra_stage=f"<stage><name>Booster</name><subcomponents>{body_tube()}"
                                                        "</subcomponents></stage>"),  # fmt: skip
         "tube fins": lambda: design_xml(stage=nose() + body_tube(tube_parts(_component("tubefinset", "Tubes", "")))),
-        "body step": lambda: design_xml(stage=nose() + body_tube() + body_tube(mount()).replace(
-            "<name>Body</name>", "<name>Wide</name>").replace(f"<radius>{R}", f"<radius>{2 * R}")),
         "no simulation": lambda: design_xml(simulations=""),
         "malformed xml": lambda: design_xml()[:-20],
         "version": lambda: design_xml(version="2.0"),
@@ -331,6 +328,46 @@ def test_each_refusal_is_one_line_naming_the_component_and_writes_nothing(tmp_pa
     message = str(refusal.value)
     assert "\n" not in message and named in message, message
     assert list(out.parent.iterdir()) == []
+
+
+def test_transitions_lugs_buttons_and_finishes_are_written(tmp_path):
+    """A widening shoulder, a wider tube and an aft narrowing transition: the shoulder and the tail become conical
+    sections (the tail narrows from the wider tube, not from the nose's diameter: no boat-tail); the lug, the rail button, the finishes (OpenRocket's roughness
+    heights) and the fins' square cross-section reach the campaign. Positions are sums of the fixture's lengths:
+    1e-12 m is their rounding."""
+    shoulder = _component("transition", "Shoulder", f"{_material(PLASTIC)}<length>0.05</length><thickness>0.001"
+                          f"</thickness><shape>conical</shape><foreradius>{R}</foreradius><aftradius>{1.2 * R}"
+                          "</aftradius><finish>rough</finish>")  # fmt: skip
+    button = _component("railbutton", "Button", f"{_material(PLASTIC)}<outerdiameter>0.01</outerdiameter>"
+                        "<innerdiameter>0.006</innerdiameter><height>0.008</height><baseheight>0.002</baseheight>"
+                        "<flangeheight>0.002</flangeheight><instancecount>2</instancecount><instanceseparation>0.1"
+                        "</instanceseparation>", "top", 0.05)  # fmt: skip
+    wide = body_tube(tube_parts(button)).replace("<name>Body</name>", "<name>Wide</name>").replace(
+        f"<radius>{R}</radius>", f"<radius>{1.2 * R}</radius><finish>polished</finish>")
+    tail = _component("transition", "Tail", f"{_material(PLASTIC)}<length>0.03</length><thickness>0.001</thickness>"
+                      f"<shape>conical</shape><foreradius>{1.2 * R}</foreradius><aftradius>{R}</aftradius>")  # fmt: skip
+    front = _component("bodytube", "Front", f"{_material(CARDBOARD)}<length>0.1</length><thickness>{WALL}"
+                       f"</thickness><radius>{R}</radius><finish>normal</finish>")  # fmt: skip
+    ork = write_ork(tmp_path, design_xml(stage=nose() + front + shoulder + wide + tail))
+    design = read_design(ork)
+    top = NOSE_L + 0.1
+    assert [name for name, _ in design.transitions] == ["Shoulder", "Tail"] and design.boat_tail is None
+    t = design.transitions[0][1]
+    assert (t.position_m, t.length_m, t.fore_diameter_m, t.aft_diameter_m) == pytest.approx(
+        (top, 0.05, 2 * R, 2.4 * R), abs=1e-12)
+    assert design.transitions[1][1].position_m == pytest.approx(top + 0.05 + TUBE_L, abs=1e-12)
+    result = import_openrocket(ork, tmp_path / "steps.toml")
+    geometry = load_campaign(result.campaign).config.rocket.geometry
+    assert geometry.surface_roughness_m == 2e-6  # the wide tube, polished, is the largest surface
+    assert any("finishes" in w for w in result.warnings)
+    diameters = [d for t in geometry.transitions for d in (t.fore_diameter_m, t.aft_diameter_m)]
+    assert diameters == pytest.approx([2 * R, 2.4 * R, 2.4 * R, 2 * R], rel=1e-6)  # 7 digits written
+    (lug,) = geometry.launch_lugs
+    assert (lug.outer_diameter_m, lug.inner_diameter_m, lug.length_m) == pytest.approx(
+        (2 * LUG_R, 2 * (LUG_R - LUG_T), LUG_L), rel=1e-6)
+    assert [b.position_m for b in geometry.rail_buttons] == pytest.approx([top + 0.1, top + 0.2], rel=1e-6)
+    assert (geometry.rail_buttons[0].height_m, geometry.rail_buttons[0].inner_height_m) == pytest.approx((0.008, 0.004))
+    assert geometry.fins[0].profile == "square" and geometry.fins[0].surface_roughness_m == 60e-6  # "normal" default
 
 
 def test_a_bare_rocket_ork_xml_is_read_too(tmp_path):

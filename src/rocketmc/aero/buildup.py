@@ -64,7 +64,7 @@ from typing import NamedTuple
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .geometry import FinSet, RocketGeometry, nose_radius_m
+from .geometry import FinSet, RocketGeometry, Transition, body_radius_m
 from .tables import PANEL_AXES, PANEL_COEFFS, CanardPanels, GriddedCoefficients
 
 MAX_SUBSONIC_MACH = 0.9
@@ -173,36 +173,38 @@ def slender_body_factors(count: int, tau: float, vortices_per_panel: int = 80) -
 # --- geometry helpers ---------------------------------------------------------------------------------
 
 
-def body_radius(geometry: RocketGeometry, x_m: np.ndarray) -> np.ndarray:
-    """Radius of the body of revolution [m] at ``x_m`` from the nose tip (0 outside the body)."""
-    x = np.asarray(x_m, dtype=float)
-    big_r = geometry.body_radius_m
-    nose = geometry.nose
-    r = np.where(x < nose.length_m, nose_radius_m(nose.kind, nose.length_m, big_r, x), big_r)
-    bt = geometry.boat_tail
-    if bt is not None:
-        frac = np.clip((x - bt.position_m) / bt.length_m, 0.0, 1.0)
-        r = np.where(x > bt.position_m, big_r + frac * (0.5 * bt.aft_diameter_m - big_r), r)
-    return np.where((x >= 0) & (x <= geometry.length_m), r, 0.0)
-
-
 def _integrate(y: np.ndarray, x: np.ndarray) -> float:
     return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
 
 
-def _area_step_cp(geometry: RocketGeometry, x_start: float, x_end: float) -> tuple[float, float]:
-    """Slender-body CNα [1/rad] and centre [m] of the section x_start..x_end: 2ΔA/S at ∫x dA / ΔA."""
+def _area_step_cp(geometry: RocketGeometry, x_start: float, x_end: float, radius) -> tuple[float, float]:
+    """Slender-body CNα [1/rad] and centre [m] of the section x_start..x_end of radius ``radius(x)`` [m]:
+    2ΔA/S at ∫x dA / ΔA."""
     x = np.linspace(x_start, x_end, 2001)
-    area = np.pi * body_radius(geometry, x) ** 2
+    area = np.pi * radius(x) ** 2
     d_area = area[-1] - area[0]
     cp = (x_end * area[-1] - x_start * area[0] - _integrate(area, x)) / d_area
     return 2 * d_area / geometry.reference_area_m2, cp
 
 
+def _section_cp(geometry: RocketGeometry, section: Transition) -> tuple[float, float]:
+    """Slender-body CNα [1/rad] and centre [m] of a conical section between its own fore and aft radii
+    (a step in front of it, where the flow separates as at a base, carries no normal force, as in
+    Barrowman's method and OpenRocket); (0, its middle) when it neither narrows nor widens."""
+    fore, aft, start = 0.5 * section.fore_diameter_m, 0.5 * section.aft_diameter_m, section.position_m
+    if fore == aft:
+        return 0.0, start + 0.5 * section.length_m
+
+    def radius(x):
+        return fore + np.clip((x - start) / section.length_m, 0.0, 1.0) * (aft - fore)
+
+    return _area_step_cp(geometry, start, start + section.length_m, radius)
+
+
 def _planform(geometry: RocketGeometry) -> tuple[float, float]:
     """Planform (side-view) area of the body [m²] and its centroid from the nose tip [m]."""
     x = np.linspace(0.0, geometry.length_m, 4001)
-    width = 2 * body_radius(geometry, x)
+    width = 2 * body_radius_m(geometry, x)
     area = _integrate(width, x)
     return area, _integrate(width * x, x) / area
 
@@ -219,9 +221,15 @@ def _fin_span_centroid_m(fins: FinSet) -> float:
     return fins.span_m / 3 * (cr + 2 * ct) / (cr + ct)
 
 
+def _fin_root_radius_m(geometry: RocketGeometry, fins: FinSet) -> float:
+    """The body's radius under a fin set, at its centre of pressure [m] (the body's own radius off the
+    body): the radius its interference and roll arm are measured from."""
+    r = float(body_radius_m(geometry, np.array(_fin_cp_m(fins))))
+    return r if r > 0 else geometry.body_radius_m
+
+
 def _fin_tau(geometry: RocketGeometry, fins: FinSet) -> float:
-    r = float(body_radius(geometry, np.array(_fin_cp_m(fins))))
-    r = r if r > 0 else geometry.body_radius_m
+    r = _fin_root_radius_m(geometry, fins)
     return r / (r + fins.span_m)
 
 
@@ -235,7 +243,7 @@ def fin_panel_cn_alpha(geometry: RocketGeometry, fins: FinSet, mach) -> np.ndarr
 
 
 def _fin_cp_radius_m(geometry: RocketGeometry, fins: FinSet) -> float:
-    return geometry.body_radius_m + _fin_span_centroid_m(fins)
+    return _fin_root_radius_m(geometry, fins) + _fin_span_centroid_m(fins)
 
 
 # --- linear build-up ----------------------------------------------------------------------------------
@@ -249,12 +257,12 @@ def normal_force_components(geometry: RocketGeometry, mach, include_canards: boo
     at α = 0 (its crossflow lift grows as sin²α).
     """
     zero = np.zeros_like(np.asarray(mach, dtype=float))
-    cn, cp = _area_step_cp(geometry, 0.0, geometry.nose.length_m)
+    cn, cp = _area_step_cp(geometry, 0.0, geometry.nose.length_m, lambda x: body_radius_m(geometry, x))
     components = [Component("nose", cn + zero, cp)]
-    if geometry.boat_tail is not None:
-        bt = geometry.boat_tail
-        cn, cp = _area_step_cp(geometry, bt.position_m, bt.position_m + bt.length_m)
-        components.append(Component("boat_tail", cn + zero, cp))
+    for i, section in enumerate(geometry.sections()):
+        is_tail = geometry.boat_tail is not None and section.position_m == geometry.boat_tail.position_m
+        cn, cp = _section_cp(geometry, section)
+        components.append(Component("boat_tail" if is_tail else f"transition{i + 1}", cn + zero, cp))
     sets = [(f"fins{i + 1}", f) for i, f in enumerate(geometry.fins)]
     if include_canards and geometry.canards is not None:
         sets.append(("canards", geometry.canards))
@@ -291,9 +299,9 @@ def _rate_derivatives(geometry, components, mach, moment_reference_m):
     """CNq and Cmq [per q·d/(2V)]: slender-body body terms plus the lifting surfaces."""
     d, s_ref = geometry.body_diameter_m, geometry.reference_area_m2
     x = np.linspace(0.0, geometry.length_m, 4001)
-    area = np.pi * body_radius(geometry, x) ** 2
+    area = np.pi * body_radius_m(geometry, x) ** 2
     arm_base = geometry.length_m - moment_reference_m
-    area_base = np.pi * float(body_radius(geometry, np.array(geometry.length_m))) ** 2
+    area_base = np.pi * float(body_radius_m(geometry, np.array(geometry.length_m))) ** 2
     # dN/dx = ρV d(A w)/dx with w = q (x − x_ref): the force and moment are set by the base section.
     zero = np.zeros_like(mach)
     cn_q = zero + 4 * area_base * arm_base / (s_ref * d)
@@ -334,7 +342,7 @@ def body_coefficients(geometry: RocketGeometry, alpha_rad, beta_rad, mach, momen
     # Potential (Jorgensen) terms: CNα/2 · sin 2α_t cos(α_t/2), divided by sin α_t to resolve.
     potential = u * np.sqrt((1 + u) / 2)  # sin 2α_t cos(α_t/2) / (2 sin α_t)
     for c in components:
-        if c.name in ("nose", "boat_tail"):
+        if not c.name.startswith(("fins", "canards")):  # nose, transitions, boat-tail
             add(-c.cn_alpha * potential * v, c.cn_alpha * potential * w, c.cp_m)
     # Viscous crossflow: η C_dc (A_p/S) sin²α_t at the planform centroid.
     planform_area, planform_x = _planform(geometry)

@@ -27,14 +27,32 @@ and FinSetCalc). Every term is a drag coefficient referenced to ``geometry.refer
   sweep, plus the trailing edge (square: the base drag, rounded: half of it, airfoil: none).
 - Base drag 0.12 + 0.13 M² (M < 1), 0.25/M (M > 1) on the aft cross-section; with the motor
   burning, on the annulus around the motor (OpenRocket subtracts the motor's area).
-- Boat-tail: the base drag on the area it removes, times 1, (3 − γ)/2 or 0 for a length-to-height
-  ratio γ = l/(d₁ − d₂) below 1, between 1 and 3, above 3.
+- Transitions (conical sections anywhere on the body, the boat-tail among them): a narrowing one the
+  base drag on the area it removes, times 1, (3 − γ)/2 or 0 for a length-to-height ratio
+  γ = l/(d₁ − d₂) below 1, between 1 and 3, above 3; a widening one the cone's pressure drag above
+  (a conical shoulder of fineness l/(d₂ − d₁) and half-angle ε, 0.8 sin²ε at rest) on the ring it adds
+  (OpenRocket technical documentation §3.4.3 and appendix B). A step in the body's diameter at a
+  section's front: the stagnation drag on the ring facing the flow, the base drag on the ring facing aft.
+- Skin friction per surface finish: each component's Cf is the larger of the smooth turbulent Cf and
+  the roughness limit of its own roughness height (OpenRocket's finishes: rough 500 µm, unfinished
+  150 µm, regular paint 60 µm, smooth paint 20 µm, polished 2 µm; ``OPENROCKET_FINISHES_M``).
+- Launch lugs (parasitic drag, Niskanen 2009 §3.4.5 after Hoerner, Fluid-Dynamic Drag (1965) ch. 3):
+  a tube in axial flow, max(1.3 − l/d, 1) times the stagnation drag on its frontal area
+  π(r_o² − r_i² max(1 − l/d, 0)) (a short lug's bore passes its air; a long one's, slowed by the
+  friction inside, counts as blocked).
+- Rail buttons: a cylinder in crossflow, the circular cylinder's drag against Mach (Gowen & Perkins,
+  NACA TN 2960 (1953), fig. 7: 1.2 at low speed) times the finite cylinder's ratio for its free end
+  (White, Fluid Mechanics, table 7.2: 0.68 at l/d = 2, the button and its mirror image in the body)
+  on the button's side profile less its waist's notch,
+  at the mean dynamic pressure over its height inside the turbulent boundary layer of the body
+  (u/U = (y/δ)^(1/7), δ = 0.37 x Re_x^−0.2 at its distance x from the nose tip; Schlichting, Boundary-
+  Layer Theory, ch. XXI), as OpenRocket's RailButtonCalc reduces it.
 
-At zero angle of attack the drag is along the body axis: CA0 = CD0. Launch lugs, rail buttons and
-other protrusions (parasitic drag) are not in the geometry and not included. Where OpenRocket's code
-and its documentation differ this follows the documentation: f_B = L/d (the code divides by the
-radius) and the tangent ogive's wave drag is the cone's (the code scales it by the shoulder angle,
-which is nearly zero for a tangent ogive).
+At zero angle of attack the drag is along the body axis: CA0 = CD0. Where OpenRocket's code and its
+documentation differ this follows the documentation: f_B = L/d (the code divides by the radius) and
+the tangent ogive's wave drag is the cone's (the code scales it by the shoulder angle, which is nearly
+zero for a tangent ogive). Rail buttons: OpenRocket also multiplies the cylinder's drag by the
+stagnation drag (0.85 q_stag/q); here the cylinder's measured drag stands alone.
 """
 
 from __future__ import annotations
@@ -49,8 +67,19 @@ from .geometry import FinSet, RocketGeometry, nose_radius_m
 GAMMA_AIR = 1.4  # ratio of specific heats [-]
 SUTHERLAND_BETA = 1.458e-6  # Sutherland's law constant [kg/(m·s·K^0.5)] (USSA 1976)
 SUTHERLAND_S = 110.4  # Sutherland's temperature [K]
-FIN_PROFILES = ("rounded", "square", "airfoil")
 BOUNDARY_LAYERS = ("turbulent", "transitional")
+OPENROCKET_FINISHES_M = {"rough": 500e-6, "unfinished": 150e-6, "normal": 60e-6, "smooth": 20e-6,
+                         "polished": 2e-6, "mirror": 0.0}  # fmt: skip
+"""OpenRocket's surface finishes and their roughness heights [m] (its ExternalComponent.Finish; "normal" is
+"regular paint", "smooth" "smooth paint")."""
+# Drag of a circular cylinder in crossflow vs Mach, subcritical Reynolds numbers (Gowen & Perkins, NACA TN
+# 2960, fig. 7, as transcribed in OpenRocket's RailButtonCalc); held at the last value beyond.
+_CYLINDER_MACH = (0.0, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 1.0, 1.6, 2.0, 2.8)
+_CYLINDER_CD = (1.2, 1.22, 1.25, 1.3, 1.4, 1.5, 1.6, 2.1, 1.5, 1.45, 1.33)
+# A finite cylinder's drag over the infinite one's vs its length over diameter (White, Fluid Mechanics, table 7.2,
+# after Hoerner); a button standing on the body is half of a cylinder twice its height (the wall a mirror).
+_FINITE_CYLINDER_LD = (1.0, 2.0, 5.0, 10.0, 20.0, 40.0)
+_FINITE_CYLINDER_RATIO = (0.64, 0.68, 0.74, 0.82, 0.91, 0.98)
 
 # Pressure drag of noses of fineness ratio 3 vs Mach (NASA TR-R-100, "Collection of zero-lift drag
 # data on bodies of revolution from free-flight investigations", p. 16, as tabulated in OpenRocket's
@@ -192,15 +221,14 @@ def mean_aerodynamic_chord_m(fins: FinSet) -> float:
     return 2 / 3 * (cr + ct - cr * ct / (cr + ct))
 
 
-def fin_pressure_drag_coefficient(fins: FinSet, mach, profile="rounded"):
+def fin_pressure_drag_coefficient(fins: FinSet, mach):
     """Pressure drag of a fin set [-] referenced to its frontal area N·t·s.
 
-    profile: "rounded" (rounded or bevelled edges, the default: the Lynx fins' hexagonal section
-    has 45° bevels), "square" (flat leading and trailing faces) or "airfoil" (rounded leading edge,
-    tapered trailing edge).
+    By ``fins.profile``: "rounded" (rounded or bevelled edges, the default: the Lynx fins' hexagonal
+    section has 45° bevels), "square" (flat leading and trailing faces) or "airfoil" (rounded leading
+    edge, tapered trailing edge).
     """
-    if profile not in FIN_PROFILES:
-        raise ValueError(f"fin profile must be one of {FIN_PROFILES}, got {profile!r}")
+    profile = fins.profile
     m = np.asarray(mach, dtype=float)
     if profile == "square":
         leading = stagnation_drag_coefficient(m)
@@ -217,16 +245,26 @@ def fin_pressure_drag_coefficient(fins: FinSet, mach, profile="rounded"):
 
 
 def _body_wetted_area_m2(geometry: RocketGeometry) -> float:
-    r, nose, tail = geometry.body_radius_m, geometry.nose, geometry.boat_tail
-    cylinder_end = tail.position_m if tail else geometry.length_m
-    area = nose_wetted_area_m2(nose.kind, nose.length_m, r) + 2 * np.pi * r * (cylinder_end - nose.length_m)
-    if tail:
-        r_aft = 0.5 * tail.aft_diameter_m
-        area += np.pi * (r + r_aft) * math.hypot(tail.length_m, r - r_aft)
-    return area
+    """The body's surface [m²]: the nose, then each cylinder and conical section to the aft end."""
+    nose = geometry.nose
+    position, radius = nose.length_m, geometry.body_radius_m
+    area = nose_wetted_area_m2(nose.kind, nose.length_m, radius)
+    for section in geometry.sections():
+        area += 2 * np.pi * radius * (section.position_m - position)
+        fore, aft = 0.5 * section.fore_diameter_m, 0.5 * section.aft_diameter_m
+        area += np.pi * (fore + aft) * math.hypot(section.length_m, fore - aft)
+        position, radius = section.position_m + section.length_m, aft
+    return area + 2 * np.pi * radius * max(geometry.length_m - position, 0.0)
 
 
 def _check(geometry: RocketGeometry):
+    end = geometry.nose.length_m
+    for section in geometry.sections():
+        if section.position_m < end - 1e-6:
+            raise ValueError(f"the conical section at {section.position_m} m overlaps the one before it (ending {end} m)")
+        end = section.position_m + section.length_m
+    if end > geometry.length_m + 1e-3:
+        raise ValueError(f"the body's sections end at {end} m, beyond its length {geometry.length_m} m")
     tail = geometry.boat_tail
     if tail and abs(tail.position_m + tail.length_m - geometry.length_m) > 1e-3:
         raise ValueError(
@@ -236,9 +274,54 @@ def _check(geometry: RocketGeometry):
         raise ValueError(f"boat-tail aft diameter {tail.aft_diameter_m} m must be below the body diameter")
 
 
-def _drag_components(
-    geometry, mach, altitude_m, power_on, motor_diameter_m, surface_roughness_m, fin_profile, boundary_layer
-):
+def _section_pressure(geometry: RocketGeometry, mach, base_cd) -> np.ndarray:
+    """Pressure drag [-] (ref S) of the conical sections and of the steps in front of them."""
+    total = np.zeros_like(mach)
+    stagnation = stagnation_drag_coefficient(mach)
+    for (_, before, fore_d), section in zip(geometry.step_diameters_m(), geometry.sections()):
+        ring = np.pi / 4 * (fore_d**2 - before**2)  # > 0: a ring facing the flow, < 0: facing aft
+        total = total + (stagnation * ring if ring > 0 else base_cd * -ring)
+        aft_d = section.aft_diameter_m
+        ring = np.pi / 4 * (aft_d**2 - fore_d**2)
+        if aft_d < fore_d:
+            height_ratio = section.length_m / (fore_d - aft_d)
+            total = total + base_cd * np.clip((3 - height_ratio) / 2, 0.0, 1.0) * -ring
+        elif aft_d > fore_d:
+            fineness = section.length_m / (aft_d - fore_d)
+            total = total + nose_pressure_drag_coefficient("conical", fineness, mach) * ring
+    return total / geometry.reference_area_m2
+
+
+def lug_drag_coefficient(geometry: RocketGeometry, mach) -> np.ndarray:
+    """Pressure drag [-] (ref S) of the launch lugs: max(1.3 − l/d, 1)·C_stag on π(r_o² − r_i² max(1 − l/d, 0))."""
+    total = np.zeros_like(np.asarray(mach, dtype=float))
+    for lug in geometry.launch_lugs:
+        slenderness = lug.length_m / lug.outer_diameter_m
+        frontal = np.pi / 4 * (lug.outer_diameter_m**2 - lug.inner_diameter_m**2 * max(1 - slenderness, 0.0))
+        total = total + max(1.3 - slenderness, 1.0) * stagnation_drag_coefficient(mach) * frontal
+    return total / geometry.reference_area_m2
+
+
+def rail_button_drag_coefficient(geometry: RocketGeometry, mach, reynolds_per_m) -> np.ndarray:
+    """Pressure drag [-] (ref S) of the rail buttons: the cylinder's Cd(M), times the finite cylinder's ratio
+    for twice the button's height, on each button's frontal area, at the mean dynamic pressure of the
+    1/7-power turbulent boundary layer over its height.
+
+    reynolds_per_m: V/ν of the flight [1/m], broadcast with ``mach``."""
+    mach = np.asarray(mach, dtype=float)
+    total = np.zeros_like(mach)
+    cylinder = np.interp(mach, _CYLINDER_MACH, _CYLINDER_CD)
+    for button in geometry.rail_buttons:
+        x = max(button.position_m, 1e-3)
+        thickness = 0.37 * x / np.maximum(reynolds_per_m * x, 1.0) ** 0.2
+        inside = np.minimum(button.height_m, thickness)  # the part of the button inside the layer [m]
+        q_ratio = (7 / 9 * inside * (inside / thickness) ** (2 / 7) + (button.height_m - inside)) / button.height_m
+        finite = np.interp(2 * button.height_m / button.outer_diameter_m, _FINITE_CYLINDER_LD, _FINITE_CYLINDER_RATIO)
+        total = total + finite * cylinder * q_ratio * button.frontal_area_m2
+    return total / geometry.reference_area_m2
+
+
+def _drag_components(geometry, mach, altitude_m, power_on, motor_diameter_m, boundary_layer):
     """Each drag term [-] (reference area of the geometry) broadcast over mach and altitude."""
     _check(geometry)
     mach, altitude_m = np.broadcast_arrays(np.asarray(mach, dtype=float), np.asarray(altitude_m, dtype=float))
@@ -249,34 +332,32 @@ def _drag_components(
     speed = mach * np.asarray(air.speed_of_sound, dtype=float)
     length, s_ref = geometry.length_m, geometry.reference_area_m2
     reynolds = speed * length * density / dynamic_viscosity(temperature)
-    cf = skin_friction_coefficient(reynolds, mach, surface_roughness_m / length, boundary_layer)
+
+    def cf(roughness_m):
+        return skin_friction_coefficient(reynolds, mach, roughness_m / length, boundary_layer)
+
+    body_cf = cf(geometry.surface_roughness_m)
 
     def fin_friction(fins: FinSet):
+        fin_cf = body_cf if fins.surface_roughness_m is None else cf(fins.surface_roughness_m)
         thickness_factor = 1 + 2 * fins.thickness_m / mean_aerodynamic_chord_m(fins)
-        return cf * thickness_factor * 2 * fins.count * fins.panel_area_m2 / s_ref
+        return fin_cf * thickness_factor * 2 * fins.count * fins.panel_area_m2 / s_ref
 
     def fin_pressure(fins: FinSet):
         frontal = fins.count * fins.thickness_m * fins.span_m
-        return fin_pressure_drag_coefficient(fins, mach, fin_profile) * frontal / s_ref
+        return fin_pressure_drag_coefficient(fins, mach) * frontal / s_ref
 
     base_cd = base_drag_coefficient(mach)
-    radius, tail = geometry.body_radius_m, geometry.boat_tail
-    aft_radius = 0.5 * tail.aft_diameter_m if tail else radius
+    radius, aft_radius = geometry.body_radius_m, 0.5 * geometry.aft_diameter_m
     base_area = np.pi * aft_radius**2
     if power_on:  # the jet fills the base over the motor's cross-section
         motor_radius = aft_radius if motor_diameter_m is None else 0.5 * motor_diameter_m
         base_area = max(base_area - np.pi * motor_radius**2, 0.0)
-    if tail:
-        height_ratio = tail.length_m / (2 * (radius - aft_radius))
-        tail_share = np.clip((3 - height_ratio) / 2, 0.0, 1.0)
-        boat_tail = base_cd * tail_share * np.pi * (radius**2 - aft_radius**2) / s_ref
-    else:
-        boat_tail = np.zeros_like(mach)
     zero = np.zeros_like(mach)
     canards = geometry.canards
     return {
         # 1 + 1/(2 f_B) with the fineness f_B = L/d: the body's curvature.
-        "friction_body": cf * (1 + radius / length) * _body_wetted_area_m2(geometry) / s_ref,
+        "friction_body": body_cf * (1 + radius / length) * _body_wetted_area_m2(geometry) / s_ref,
         "friction_fins": sum((fin_friction(f) for f in geometry.fins), zero),
         "friction_canards": fin_friction(canards) if canards else zero,
         "nose_pressure": nose_pressure_drag_coefficient(
@@ -284,7 +365,9 @@ def _drag_components(
         ),
         "fin_pressure": sum((fin_pressure(f) for f in geometry.fins), zero),
         "canard_pressure": fin_pressure(canards) if canards else zero,
-        "boat_tail_pressure": boat_tail,
+        "transition_pressure": _section_pressure(geometry, mach, base_cd),
+        "launch_lugs": lug_drag_coefficient(geometry, mach),
+        "rail_buttons": rail_button_drag_coefficient(geometry, mach, reynolds / length),
         "base": base_cd * base_area / s_ref,
     }
 
@@ -296,22 +379,17 @@ def zero_lift_axial_coefficient(
     *,
     power_on: bool = False,
     motor_diameter_m: float | None = None,
-    surface_roughness_m: float = 20e-6,
-    fin_profile: str = "rounded",
     boundary_layer: str = "turbulent",
 ) -> np.ndarray:
     """Axial force coefficient at zero lift CA0 = CD0 [-] (reference ``geometry.reference_area_m2``).
 
     Broadcasts over ``mach`` [-] and ``altitude_m`` (above mean sea level, ISA) [m]. Includes the
-    body, every fin set and the canards at zero deflection. power_on: the motor is burning, and its
-    jet fills ``motor_diameter_m`` [m] of the base (None: the whole base, no base drag);
-    surface_roughness_m: roughness height Rs [m] (20 µm: aircraft paint, OpenRocket's "smooth");
-    fin_profile: see ``fin_pressure_drag_coefficient``; boundary_layer: see
-    ``skin_friction_coefficient``.
+    body, its transitions, every fin set, the canards at zero deflection, the launch lugs and rail
+    buttons; each surface's roughness is the geometry's (``surface_roughness_m`` of the body and of
+    each fin set). power_on: the motor is burning, and its jet fills ``motor_diameter_m`` [m] of the
+    base (None: the whole base, no base drag); boundary_layer: see ``skin_friction_coefficient``.
     """
-    terms = _drag_components(
-        geometry, mach, altitude_m, power_on, motor_diameter_m, surface_roughness_m, fin_profile, boundary_layer
-    )
+    terms = _drag_components(geometry, mach, altitude_m, power_on, motor_diameter_m, boundary_layer)
     return sum(terms.values())
 
 
@@ -322,20 +400,17 @@ def drag_breakdown(
     power_on: bool = False,
     *,
     motor_diameter_m: float | None = None,
-    surface_roughness_m: float = 20e-6,
-    fin_profile: str = "rounded",
     boundary_layer: str = "turbulent",
 ) -> dict[str, float]:
     """CD0 [-] of each component at one Mach and altitude [m], plus their sum under "total".
 
     Keys: friction_body, friction_fins, friction_canards, nose_pressure, fin_pressure,
-    canard_pressure, boat_tail_pressure, base, total; arguments as ``zero_lift_axial_coefficient``.
+    canard_pressure, transition_pressure (the boat-tail's included), launch_lugs, rail_buttons, base,
+    total; arguments as ``zero_lift_axial_coefficient``.
     """
     if np.ndim(mach) or np.ndim(altitude_m):
         raise ValueError("drag_breakdown takes a scalar Mach and altitude")
-    terms = _drag_components(
-        geometry, mach, altitude_m, power_on, motor_diameter_m, surface_roughness_m, fin_profile, boundary_layer
-    )
+    terms = _drag_components(geometry, mach, altitude_m, power_on, motor_diameter_m, boundary_layer)
     breakdown = {name: float(value) for name, value in terms.items()}
     breakdown["total"] = sum(breakdown.values())
     return breakdown

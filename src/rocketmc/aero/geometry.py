@@ -2,6 +2,11 @@
 
 Plain host-side dataclasses (they build tables, they are never traced). Positions are distances
 from the nose tip, positive aft [m]; a fin set's position is the leading edge of its root chord.
+
+The body of revolution is the nose (base diameter ``body_diameter_m``, the reference length) followed by
+cylinders and conical transitions: each transition (and the aft ``boat_tail``) starts at its ``position_m``,
+the body between them is a cylinder of the diameter the previous one ended with. A transition whose fore
+diameter differs from that diameter makes a step (a forward- or aft-facing annulus).
 """
 
 from __future__ import annotations
@@ -12,6 +17,10 @@ import math
 import numpy as np
 
 NOSE_KINDS = ("von_karman", "ogive", "conical", "elliptical", "parabolic", "haack_lv")
+FIN_PROFILES = ("rounded", "square", "airfoil")
+"""A fin's cross-section at its edges (``aero.drag.fin_pressure_drag_coefficient``)."""
+DEFAULT_ROUGHNESS_M = 20e-6
+"""Surface roughness height when none is given [m]: 20 µm, smooth paint (OpenRocket's "smooth")."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -69,8 +78,12 @@ class FinSet:
     thickness_m: float = 0.005
     cant_deg: float = 0.0
     first_panel_deg: float = 0.0
+    profile: str = "rounded"
+    surface_roughness_m: float | None = None
 
     def __post_init__(self):
+        if self.profile not in FIN_PROFILES:
+            raise ValueError(f"fin profile must be one of {FIN_PROFILES}, got {self.profile!r}")
         if self.count < 1:
             raise ValueError(f"fin count must be >= 1, got {self.count}")
         for name in ("root_chord_m", "span_m"):
@@ -107,9 +120,55 @@ class BoatTail:
 
 
 @dataclasses.dataclass(frozen=True)
+class Transition:
+    """Conical section from ``fore_diameter_m`` to ``aft_diameter_m`` over ``length_m``, its front
+    ``position_m`` from the nose tip [m]; narrowing or widening."""
+
+    position_m: float
+    length_m: float
+    fore_diameter_m: float
+    aft_diameter_m: float
+
+    def __post_init__(self):
+        if not self.length_m > 0:
+            raise ValueError(f"transition length must be > 0 m, got {self.length_m}")
+        if not (self.fore_diameter_m >= 0 and self.aft_diameter_m >= 0):
+            raise ValueError("transition diameters must be >= 0 m")
+
+
+@dataclasses.dataclass(frozen=True)
+class LaunchLug:
+    """A launch lug: a tube along the body, its front end ``position_m`` from the nose tip [m]."""
+
+    position_m: float
+    length_m: float
+    outer_diameter_m: float
+    inner_diameter_m: float
+
+
+@dataclasses.dataclass(frozen=True)
+class RailButton:
+    """A rail button standing ``height_m`` off the body at ``position_m`` (its axis) [m]: a flange of
+    ``outer_diameter_m`` whose waist (``inner_diameter_m``, ``inner_height_m`` high) holds the rail."""
+
+    position_m: float
+    height_m: float
+    outer_diameter_m: float
+    inner_diameter_m: float
+    inner_height_m: float
+
+    @property
+    def frontal_area_m2(self) -> float:
+        """Area the button shows the flow [m²]: its side profile less the waist's notch."""
+        notch = (self.outer_diameter_m - self.inner_diameter_m) * self.inner_height_m
+        return self.height_m * self.outer_diameter_m - notch
+
+
+@dataclasses.dataclass(frozen=True)
 class RocketGeometry:
-    """Body of revolution (nose + cylinder of ``body_diameter_m`` up to ``length_m`` from the tip,
-    optional boat-tail at its end) with tail fin sets and optional movable canards [m]."""
+    """Body of revolution (nose, then cylinders and conical ``transitions``, the optional ``boat_tail``
+    at the aft end, ``length_m`` from the tip) with tail fin sets, optional movable canards, launch lugs
+    and rail buttons [m]. surface_roughness_m: the body's roughness height [m]."""
 
     body_diameter_m: float
     length_m: float
@@ -117,6 +176,10 @@ class RocketGeometry:
     fins: tuple[FinSet, ...] = ()
     canards: FinSet | None = None
     boat_tail: BoatTail | None = None
+    transitions: tuple[Transition, ...] = ()
+    launch_lugs: tuple[LaunchLug, ...] = ()
+    rail_buttons: tuple[RailButton, ...] = ()
+    surface_roughness_m: float = DEFAULT_ROUGHNESS_M
 
     @property
     def body_radius_m(self) -> float:
@@ -126,6 +189,46 @@ class RocketGeometry:
     def reference_area_m2(self) -> float:
         """Cross-section of the body, the usual reference area [m²]."""
         return math.pi * self.body_radius_m**2
+
+    def sections(self) -> tuple[Transition, ...]:
+        """Every conical section aft of the nose, front to back: the transitions and the boat-tail
+        (from the diameter before it)."""
+        ordered = sorted(self.transitions, key=lambda t: t.position_m)
+        tail = self.boat_tail
+        if tail is not None:
+            before = [t for t in ordered if t.position_m < tail.position_m]
+            fore = before[-1].aft_diameter_m if before else self.body_diameter_m
+            ordered.append(Transition(tail.position_m, tail.length_m, fore, tail.aft_diameter_m))
+        return tuple(ordered)
+
+    def step_diameters_m(self) -> list[tuple[float, float, float]]:
+        """(position [m], diameter before, diameter after [m]) at each section's front: where the body's
+        diameter jumps (the two equal when it does not)."""
+        steps, diameter = [], self.body_diameter_m
+        for t in self.sections():
+            steps.append((t.position_m, diameter, t.fore_diameter_m))
+            diameter = t.aft_diameter_m
+        return steps
+
+    @property
+    def aft_diameter_m(self) -> float:
+        """The body's diameter at its aft end [m]."""
+        sections = self.sections()
+        return sections[-1].aft_diameter_m if sections else self.body_diameter_m
+
+
+def body_radius_m(geometry: RocketGeometry, x_m) -> np.ndarray:
+    """Radius of the body of revolution [m] at ``x_m`` from the nose tip [m] (0 outside the body); at a
+    step, the section's fore radius."""
+    x = np.asarray(x_m, dtype=float)
+    big_r = geometry.body_radius_m
+    nose = geometry.nose
+    r = np.where(x < nose.length_m, nose_radius_m(nose.kind, nose.length_m, big_r, x), big_r)
+    for t in geometry.sections():
+        fore, aft = 0.5 * t.fore_diameter_m, 0.5 * t.aft_diameter_m
+        frac = np.clip((x - t.position_m) / t.length_m, 0.0, 1.0)
+        r = np.where(x >= t.position_m, fore + frac * (aft - fore), r)
+    return np.where((x >= 0) & (x <= geometry.length_m), r, 0.0)
 
 
 LYNX_AS_FLOWN = RocketGeometry(

@@ -31,6 +31,7 @@ MAX_MASS_KG = 5000.0  # a few tonnes: the heaviest amateur rockets weigh under 2
 MIN_LENGTH_M = 1e-4  # 0.1 mm, thinner than any fin
 MAX_LENGTH_M = 100.0  # lengths and positions: amateur rockets are under 20 m long
 MAX_DIAMETER_M = 10.0  # diameters: amateur rockets are under 1 m across
+MAX_ROUGHNESS_M = 0.01  # surface roughness heights: OpenRocket's roughest finish is 0.5 mm; 1 cm is gravel
 MAX_AREA_M2 = 1000.0  # canopy and reference areas: the largest cargo canopies have ~700 m²
 MIN_INERTIA_KGM2 = 1e-9  # a 1 g rod 5 mm across has an axial inertia of 3·10⁻⁹ kg·m²; it divides every moment
 MAX_INERTIA_KGM2 = 1e7  # a 5 t, 100 m rod about its middle has m·L²/12 ≈ 4·10⁶ kg·m²

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
-from ..aero.geometry import BoatTail, FinSet, Nose, RocketGeometry
+from ..aero.geometry import BoatTail, FinSet, LaunchLug, Nose, RailButton, RocketGeometry, Transition
 from ..aero.io import load_aero
 from ..aero.model import LinearAero, TableAero, simplify
 from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_increment, with_axial_curve, with_canards
@@ -429,7 +429,9 @@ def _check_elevation_unit(elevation_deg: float) -> None:
 def _check_geometry(rocket: RocketConfig) -> None:
     """The build-up's shape can be built: every fin set's and the canards' root chord on the body (from the
     nose tip to the aft end), the canards clear of every fin set, a boat-tail behind the nose and ending at
-    or before the aft end, narrowing; one line naming the field."""
+    or before the aft end, narrowing; the transitions between the nose's end and the aft end (the
+    boat-tail's front), one after the other without overlapping; lugs and buttons on the body; one line
+    naming the field."""
     g = rocket.geometry
     if g is None:
         return
@@ -459,6 +461,21 @@ def _check_geometry(rocket: RocketConfig) -> None:
         if tail.aft_diameter_m > g.body_diameter_m:
             raise ConfigError(f"rocket.geometry.boat_tail.aft_diameter_m: {tail.aft_diameter_m:g} m exceeds the body's "
                               f"diameter ({g.body_diameter_m:g} m); a boat-tail narrows")  # fmt: skip
+    end = length if tail is None else rocket.from_nose(tail.position_m)
+    previous_end, previous = g.nose.length_m, "the nose"
+    for i, t in sorted(enumerate(g.transitions), key=lambda item: rocket.from_nose(item[1].position_m)):
+        start = rocket.from_nose(t.position_m)
+        if start < previous_end - eps or start + t.length_m > end + eps:
+            raise ConfigError(f"rocket.geometry.transitions.{i}.position_m: the transition spans {start:g} to "
+                              f"{start + t.length_m:g} m from the nose tip, overlapping {previous} (ending at "
+                              f"{previous_end:g} m) or past {'the boat-tail' if tail else 'the aft end'} ({end:g} m)")  # fmt: skip
+        previous_end, previous = start + t.length_m, f"transitions.{i}"
+    for path, parts in (("launch_lugs", g.launch_lugs), ("rail_buttons", g.rail_buttons)):
+        for i, part in enumerate(parts):
+            start = rocket.from_nose(part.position_m)
+            if not -eps <= start <= length + eps:
+                raise ConfigError(f"rocket.geometry.{path}.{i}.position_m: {start:g} m from the nose tip, off the body "
+                                  f"(0 to length_m = {length:g} m)")  # fmt: skip
 
 
 def _check_avionics(config: CampaignConfig) -> None:
@@ -583,27 +600,33 @@ def _weather(config: CampaignConfig, base_dir: Path) -> Weather | None:
     return weather
 
 
-def _rocket_geometry(rocket: RocketConfig) -> RocketGeometry:
+def rocket_geometry(rocket: RocketConfig) -> RocketGeometry:
     """The build-up's ``RocketGeometry`` of ``rocket.geometry``, its positions from the nose tip [m]."""
     g, from_nose = rocket.geometry, rocket.from_nose
 
     def fin_set(f: FinSetConfig) -> FinSet:
         return FinSet(**{**f.model_dump(), "position_m": from_nose(f.position_m)})
 
-    tail = g.boat_tail
+    def placed(kind, item):  # a part whose position_m is its front or axis: from the nose tip
+        return kind(**{**item.model_dump(), "position_m": from_nose(item.position_m)})
+
     return RocketGeometry(
         g.body_diameter_m,
         g.length_m,
         Nose(**g.nose.model_dump()),
         tuple(fin_set(f) for f in g.fins),
         None if g.canards is None else fin_set(g.canards),
-        None if tail is None else BoatTail(**{**tail.model_dump(), "position_m": from_nose(tail.position_m)}),
+        None if g.boat_tail is None else placed(BoatTail, g.boat_tail),
+        tuple(placed(Transition, t) for t in g.transitions),
+        tuple(placed(LaunchLug, lug) for lug in g.launch_lugs),
+        tuple(placed(RailButton, b) for b in g.rail_buttons),
+        g.surface_roughness_m,
     )
 
 
 def _aero_tables(rocket: RocketConfig, base_dir: Path) -> AeroTables:
     aero = rocket.aero
-    geometry = None if rocket.geometry is None else _rocket_geometry(rocket)
+    geometry = None if rocket.geometry is None else rocket_geometry(rocket)
     try:
         if aero.tables == "buildup":
             tables = build_up_tables(geometry, rocket.from_nose(rocket.reference_point_m))
@@ -633,7 +656,7 @@ def _power_on_table(rocket: RocketConfig) -> Table | None:
     if aero.cd_power_on is not None:
         mach, increment = aero.cd_mach, np.subtract(aero.cd_power_on, aero.cd)
     elif aero.tables == "buildup" and aero.cd is None:
-        geometry = _rocket_geometry(rocket)
+        geometry = rocket_geometry(rocket)
         mach, increment = power_on_axial_increment(geometry, rocket.motor.grain_outer_diameter_m)
     else:
         return None

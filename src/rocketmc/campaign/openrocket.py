@@ -22,7 +22,8 @@ from xml.etree import ElementTree
 
 import numpy as np
 
-from ..aero.geometry import FinSet, nose_radius_m
+from ..aero.drag import OPENROCKET_FINISHES_M
+from ..aero.geometry import FinSet, LaunchLug, RailButton, Transition, nose_radius_m
 from ..dynamics.rigid_body import MassProperties
 from . import openrocket_mass as om
 from .errors import ConfigError
@@ -115,8 +116,11 @@ class Design:
     body_names: list[str]
     length_m: float
     boat_tail: tuple[str, float, float, float] | None  # (name, length, aft diameter, front end) [m]
+    transitions: list[tuple[str, Transition]]  # (name, shape) of each other change of the body's diameter
+    surface_roughness_m: float  # the body's, from its largest component's finish [m]
     fins: list[ImportedFins]
     lugs: list[tuple[str, float]]  # (name, aft end) of each lug or rail button instance
+    lug_shapes: list[tuple[str, LaunchLug | RailButton]]  # (name, shape) of each lug and rail button instance
     recovery: list[Recovery]
     mounts: list[tuple[str, ElementTree.Element, float, float]]  # (name, <motormount>, front end, length)
     dry: MassProperties
@@ -236,6 +240,7 @@ class _Reader:
         self.body: list[tuple[str, str, ElementTree.Element, float, float]] = []  # kind, name, element, top, length
         self.fins: list[ImportedFins] = []
         self.lugs: list[tuple[str, float]] = []
+        self.lug_shapes: list[tuple[str, LaunchLug | RailButton]] = []
         self.recovery: list[Recovery] = []
         self.mounts: list[tuple[str, ElementTree.Element, float, float]] = []
         self.warnings: list[str] = []
@@ -258,7 +263,7 @@ class _Reader:
             raise OpenRocketError("the rocket has no mass")
         profile = self._profile()
         return Design(name=(self.rocket.findtext("name") or "rocket").strip(), version=self.root.get("version"),
-                      **profile, fins=self.fins, lugs=self.lugs, recovery=self.recovery, mounts=self.mounts, dry=dry,
+                      **profile, fins=self.fins, lugs=self.lugs, lug_shapes=self.lug_shapes, recovery=self.recovery, mounts=self.mounts, dry=dry,
                       parts=self.parts, warnings=self.warnings,
                       simulations=self.root.findall("simulations/simulation"))  # fmt: skip
 
@@ -350,6 +355,9 @@ class _Reader:
         if tag in ASSEMBLIES:
             return None
         self.parts += 1
+        if element.find("overridecd") is not None:
+            self.warnings.append(f"component {name!r}: its drag override (Cd {element.findtext('overridecd')}) is not "
+                                 "flown: rocketmc computes the drag of every component from its shape")  # fmt: skip
         if element.find("motormount") is not None:
             self.mounts.append((name, element.find("motormount"), top_m, length_m))
         if tag in BODY_KINDS:
@@ -508,6 +516,7 @@ class _Reader:
         instances = self._instances(element)
         if tag == "launchlug":
             self.lugs.extend((name, top_m + x + length_m) for x in instances)
+            self.lug_shapes.extend((name, LaunchLug(top_m + x, length_m, 2 * outer, 2 * inner)) for x in instances)
         return om.combined([om.moved(ring, x) for x in instances])
 
     def _instances(self, element) -> list[float]:
@@ -528,6 +537,8 @@ class _Reader:
         volume = math.pi * (outer**2 * (flange + base + 2 * screw / 3) + inner**2 * max(height - base - flange, 0.0))
         instances = self._instances(element)
         self.lugs.extend((name, top_m + x) for x in instances)
+        waist = max(height - base - flange, 0.0)
+        self.lug_shapes.extend((name, RailButton(top_m + x, height, 2 * outer, 2 * inner, waist)) for x in instances)
         each = volume * _material_density(element)
         return om.combined([om.point(each, top_m + x) for x in instances])
 
@@ -589,8 +600,11 @@ class _Reader:
             note = (f"{what} fins flown as the trapezoid of the same span, root chord and {kept}; rocketmc's fins "
                     "are trapezoidal")  # fmt: skip
             self.warnings.append(f"fin set {name!r}: {note}")
+        profile = (element.findtext("crosssection") or "square").strip()
         self.fins.append(ImportedFins(name, FinSet(count, shape.root_chord_m, shape.tip_chord_m, shape.span_m,
-                                                   shape.sweep_m, top_m, thickness, cant), note))
+                                                   shape.sweep_m, top_m, thickness, cant,
+                                                   profile=profile if profile in CROSS_SECTIONS else "square",
+                                                   surface_roughness_m=self._roughness(element)), note))  # fmt: skip
         body_radius = self._body_radius(parent)
         factor = CROSS_SECTIONS.get((element.findtext("crosssection") or "square").strip(), 1.0)
         density = _material_density(element)
@@ -615,33 +629,48 @@ class _Reader:
                               [centre + length_m / 2, -height_m], [centre - length_m / 2, -height_m]])  # fmt: skip
         return om.fin_set(om.planform(rectangle), count, thickness_m, density, body_radius_m)
 
+    def _roughness(self, element) -> float:
+        """The roughness height [m] of ``element``'s ``<finish>`` (OpenRocket's default: regular paint)."""
+        finish = (element.findtext("finish") or "normal").strip()
+        if finish not in OPENROCKET_FINISHES_M:
+            self._refuse(element, f"an unknown surface finish {finish!r}")
+        return OPENROCKET_FINISHES_M[finish]
+
     def _profile(self) -> dict:
-        """The body as rocketmc describes it: nose, one diameter, an optional boat-tail at the aft end."""
+        """The body as rocketmc describes it: the nose, its base diameter, the aft narrowing transition as the
+        boat-tail, every other change of diameter (transitions, tubes of another diameter) as a conical section;
+        the body's roughness that of its largest surface."""
         if not self.body or self.body[0][0] != "nosecone":
             raise OpenRocketError("the rocket does not start with a nose cone")
         nose_kind, nose_name, nose_element, nose_top, nose_length = self.body[0]
         if _flag(nose_element, "isflipped"):
             self._refuse(nose_element, "a flipped nose cone (a tail cone)")
-        radius = self._end_radii(nose_element)[1]
-        boat_tail, names = None, []
+        radius = body_radius = self._end_radii(nose_element)[1]
+        boat_tail, transitions, names = None, [], []
         for i, (kind, name, element, top, length) in enumerate(self.body[1:], start=1):
             fore, aft = self._end_radii(element)
-            last = i == len(self.body) - 1
-            if kind == "transition" and last and abs(fore - radius) < RADIUS_TOLERANCE_M and aft < fore:
-                if (element.findtext("shape") or "conical").strip() != "conical":
-                    self.warnings.append(f"transition {name!r}: a {element.findtext('shape')} boat-tail flown as "
-                                         "a conical one of the same length and diameters")  # fmt: skip
+            same = abs(fore - radius) < RADIUS_TOLERANCE_M
+            if kind == "transition" and (element.findtext("shape") or "conical").strip() != "conical":
+                self.warnings.append(f"transition {name!r}: a {element.findtext('shape')} transition flown as a "
+                                     "conical one of the same length and diameters")  # fmt: skip
+            if kind == "transition" and i == len(self.body) - 1 and same and aft < fore and radius == body_radius:
                 boat_tail = (name, length, 2 * aft, top)
-            elif kind == "transition" or abs(fore - radius) > RADIUS_TOLERANCE_M:
-                self._refuse(element, f"the body's diameter changes here ({2 * fore:.4g} m to {2 * aft:.4g} m): "
-                                      "rocketmc flies one body diameter with an optional boat-tail at the aft end, "
-                                      "narrowing")  # fmt: skip
-            else:
+            elif kind == "transition" or not same:
+                fore = radius if same else fore
+                transitions.append((name, Transition(top, length, 2 * fore, 2 * aft)))
+            elif abs(radius - body_radius) < RADIUS_TOLERANCE_M:
                 names.append(name)
+            radius = aft if kind == "transition" or not same else radius
+        areas = [(length * (sum(self._end_radii(e)) + 1e-12), e) for _, _, e, _, length in self.body]
+        finishes = {(e.findtext("finish") or "normal").strip() for _, e in areas}
+        largest = max(areas, key=lambda item: item[0])[1]
+        if len(finishes) > 1:
+            self.warnings.append(f"the body's components have the finishes {', '.join(sorted(finishes))}: the body "
+                                 f"flies the roughness of its largest, {self._name(largest)!r}")  # fmt: skip
         end = self.body[-1][3] + self.body[-1][4]
         return dict(nose_name=nose_name, nose_kind=self._nose_kind(nose_element), nose_length_m=nose_length,
-                    body_diameter_m=2 * radius, body_names=names, length_m=end - nose_top, boat_tail=boat_tail)
-
+                    body_diameter_m=2 * body_radius, body_names=names, length_m=end - nose_top, boat_tail=boat_tail,
+                    transitions=transitions, surface_roughness_m=self._roughness(largest))  # fmt: skip
 
 
 @dataclasses.dataclass(frozen=True)

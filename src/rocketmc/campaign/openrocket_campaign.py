@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..aero.geometry import LaunchLug, RailButton
 from ..dynamics.motor_library import MotorEntry, MotorLibraryError, find_motor
 from ..dynamics.propulsion import ThrustCurveError, read_thrust_curve
 from ..dynamics.rigid_body import MassProperties
@@ -298,16 +299,33 @@ def _lugs(toml: _Toml, design: Design, mount: MotorMount, warnings: list[str]) -
                                           "the top")  # fmt: skip
 
 
+def _inline(**values: float) -> str:
+    """A TOML inline table of floats."""
+    return "{ " + ", ".join(f"{key} = {_float(value)}" for key, value in values.items()) + " }"
+
+
 def _geometry(toml: _Toml, design: Design) -> None:
     toml.table("rocket.geometry")
     body = ", ".join(repr(n) for n in design.body_names) or "the nose cone's base"
     toml.key("body_diameter_m", design.body_diameter_m, body)
     toml.key("length_m", design.length_m, "nose tip to the aft end")
     toml.key("nose", f'{{ kind = "{design.nose_kind}", length_m = {_float(design.nose_length_m)} }}', repr(design.nose_name))
+    toml.key("surface_roughness_m", design.surface_roughness_m, "the body's finish (OpenRocket's roughness height)")
     if design.boat_tail is not None:
         name, length, aft, top = design.boat_tail
-        toml.key("boat_tail", f"{{ length_m = {_float(length)}, aft_diameter_m = {_float(aft)}, position_m = "
-                              f"{_float(top)} }}", repr(name))  # fmt: skip
+        toml.key("boat_tail", _inline(length_m=length, aft_diameter_m=aft, position_m=top), repr(name))
+    if design.transitions:
+        toml.key("transitions", "[", "conical sections: OpenRocket's transitions and tubes of another diameter")
+        for name, t in design.transitions:
+            toml.lines.append(f"    {_inline(position_m=t.position_m, length_m=t.length_m, fore_diameter_m=t.fore_diameter_m, aft_diameter_m=t.aft_diameter_m)},  # {_one_line(repr(name))}")
+        toml.lines.append("]")
+    for key, kind in (("launch_lugs", LaunchLug), ("rail_buttons", RailButton)):
+        parts = [(name, part) for name, part in design.lug_shapes if isinstance(part, kind)]
+        if parts:
+            toml.key(key, "[", "one per instance; position_m: a lug's front end, a button's axis")
+            for name, part in parts:
+                toml.lines.append(f"    {_inline(**dataclasses.asdict(part))},  # {_one_line(repr(name))}")
+            toml.lines.append("]")
     for fins in design.fins:
         toml.table("rocket.geometry.fins", array=True)
         if fins.note:
@@ -318,6 +336,9 @@ def _geometry(toml: _Toml, design: Design) -> None:
             toml.key(key, getattr(shape, key))
         toml.key("position_m", shape.position_m, "the root's leading edge")
         toml.key("thickness_m", shape.thickness_m)
+        toml.key("profile", _string(shape.profile), "OpenRocket's cross-section")
+        if shape.surface_roughness_m != design.surface_roughness_m:
+            toml.key("surface_roughness_m", shape.surface_roughness_m, "the fins' own finish")
         if shape.cant_deg:
             toml.key("cant_deg", shape.cant_deg)
 

@@ -10,7 +10,7 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
-from ..aero.geometry import NOSE_KINDS
+from ..aero.geometry import DEFAULT_ROUGHNESS_M, FIN_PROFILES, NOSE_KINDS
 from ..env.magnetic import igrf_validity
 from ..env.wind import POWER_LAW_FLOOR_M
 from ..sensors.parts import load_part, part_names
@@ -43,6 +43,7 @@ from .limits import (
     MAX_NAME_LENGTH,
     MAX_RATE_DEG_S,
     MAX_REALIZATIONS,
+    MAX_ROUGHNESS_M,
     MAX_SCALE,
     MAX_SENSOR_LATENCY_S,
     MAX_SENSOR_VALUE,
@@ -69,6 +70,7 @@ Position = Annotated[float, Field(ge=-MAX_LENGTH_M, le=MAX_LENGTH_M, description
 Length = Annotated[float, Field(ge=MIN_LENGTH_M, le=MAX_LENGTH_M)]
 Diameter = Annotated[float, Field(ge=MIN_LENGTH_M, le=MAX_DIAMETER_M)]
 Area = Annotated[float, Field(gt=0, le=MAX_AREA_M2)]
+Roughness = Annotated[float, Field(ge=0, le=MAX_ROUGHNESS_M)]
 Inertia = Annotated[float, Field(ge=MIN_INERTIA_KGM2, le=MAX_INERTIA_KGM2)]
 Scale = Annotated[float, Field(gt=0, le=MAX_SCALE)]
 Delay = Annotated[float, Field(ge=0, le=MAX_DELAY_S)]
@@ -229,6 +231,8 @@ class FinSetConfig(_Strict):
     thickness_m: Length = Field(0.005, description="panel thickness")
     cant_deg: float = Field(0.0, ge=-15, le=15, description="cant angle, positive as a positive deflection")
     first_panel_deg: Direction = Field(0.0, description="roll position of panel 1, 0 up, 90 starboard")
+    profile: Literal[FIN_PROFILES] = Field("rounded", description="edges: rounded (or bevelled), square or airfoil")
+    surface_roughness_m: Roughness | None = Field(None, description="roughness height of the panels (none: the body's)")
 
 
 class BoatTailConfig(_Strict):
@@ -237,15 +241,51 @@ class BoatTailConfig(_Strict):
     position_m: Position = Field(description="its forward end, in the rocket's coordinates [m]")
 
 
+class TransitionConfig(_Strict):
+    """A conical section of the body, narrowing or widening; the body behind it keeps its aft diameter."""
+
+    position_m: Position = Field(description="its forward end, in the rocket's coordinates [m]")
+    length_m: Length = Field(description="along the axis")
+    fore_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M, description="at its forward end")
+    aft_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M, description="at its aft end")
+
+
+class LaunchLugConfig(_Strict):
+    """A launch lug, a tube along the body (one entry per lug)."""
+
+    position_m: Position = Field(description="its forward end, in the rocket's coordinates [m]")
+    length_m: Length
+    outer_diameter_m: Diameter
+    inner_diameter_m: float = Field(0.0, ge=0, le=MAX_DIAMETER_M, description="its bore (0: solid)")
+
+
+class RailButtonConfig(_Strict):
+    """A rail button (one entry per button)."""
+
+    position_m: Position = Field(description="its axis, in the rocket's coordinates [m]")
+    height_m: Length = Field(description="how far it stands off the body")
+    outer_diameter_m: Diameter = Field(description="the flanges' diameter")
+    inner_diameter_m: float = Field(0.0, ge=0, le=MAX_DIAMETER_M, description="the waist's diameter (0: no waist)")
+    inner_height_m: float = Field(0.0, ge=0, le=MAX_LENGTH_M, description="the waist's height")
+
+
 class GeometryConfig(_Strict):
     """External shape for the aerodynamic build-up; positions in the rocket's coordinates [m]."""
 
-    body_diameter_m: Diameter = Field(description="the body tube's diameter (the reference length d)")
+    body_diameter_m: Diameter = Field(description="the nose's base diameter (the reference length d)")
     length_m: Length = Field(description="from the nose tip to the aft end")
     nose: NoseConfig
     fins: list[FinSetConfig] = []
     canards: FinSetConfig | None = None
     boat_tail: BoatTailConfig | None = None
+    transitions: list[TransitionConfig] = []
+    launch_lugs: list[LaunchLugConfig] = []
+    rail_buttons: list[RailButtonConfig] = []
+    surface_roughness_m: Roughness = Field(
+        DEFAULT_ROUGHNESS_M,
+        description="roughness height of the body's surface; OpenRocket's finishes: rough 5e-4, unfinished 1.5e-4, "
+        "regular paint 6e-5, smooth paint 2e-5, polished 2e-6",
+    )
 
     @model_validator(mode="after")
     def _nose_on_the_body(self):
