@@ -36,7 +36,8 @@ and FinSetCalc). Every term is a drag coefficient referenced to ``geometry.refer
 - Skin friction per surface finish: each component's Cf is the larger of the smooth turbulent Cf and
   the roughness limit of its own roughness height (OpenRocket's finishes: rough 500 µm, unfinished
   150 µm, regular paint 60 µm, smooth paint 20 µm, polished 2 µm; ``OPENROCKET_FINISHES_M``).
-- Launch lugs (parasitic drag, Niskanen 2009 §3.4.5 after Hoerner, Fluid-Dynamic Drag (1965) ch. 3):
+- Launch lugs (parasitic drag, Niskanen 2009 §3.4.5 after Hoerner, Fluid-Dynamic Drag (1965) ch. 3; checked against
+  OpenRocket's launch-lug calculation, which uses the same factor and area):
   a tube in axial flow, max(1.3 − l/d, 1) times the stagnation drag on its frontal area
   π(r_o² − r_i² max(1 − l/d, 0)) (a short lug's bore passes its air; a long one's, slowed by the
   friction inside, counts as blocked).
