@@ -231,8 +231,8 @@ class FinSetConfig(_Strict):
     thickness_m: Length = Field(0.005, description="panel thickness")
     cant_deg: float = Field(0.0, ge=-15, le=15, description="cant angle, positive as a positive deflection")
     first_panel_deg: Direction = Field(0.0, description="roll position of panel 1, 0 up, 90 starboard")
-    profile: Literal[FIN_PROFILES] = Field("rounded", description="edges: rounded (or bevelled), square or airfoil")
-    surface_roughness_m: Roughness | None = Field(None, description="roughness height of the panels (none: the body's)")
+    profile: Literal[FIN_PROFILES] = _added("rounded", "edges: rounded (or bevelled), square or airfoil")
+    surface_roughness_m: Roughness | None = _added(None, "roughness height of the panels (none: the body's)")
 
 
 class BoatTailConfig(_Strict):
@@ -278,12 +278,12 @@ class GeometryConfig(_Strict):
     fins: list[FinSetConfig] = []
     canards: FinSetConfig | None = None
     boat_tail: BoatTailConfig | None = None
-    transitions: list[TransitionConfig] = []
-    launch_lugs: list[LaunchLugConfig] = []
-    rail_buttons: list[RailButtonConfig] = []
-    surface_roughness_m: Roughness = Field(
+    transitions: list[TransitionConfig] = _added([], "conical sections of the body, narrowing or widening, anywhere")
+    launch_lugs: list[LaunchLugConfig] = _added([], "launch lugs (their drag)")
+    rail_buttons: list[RailButtonConfig] = _added([], "rail buttons (their drag)")
+    surface_roughness_m: Roughness = _added(
         DEFAULT_ROUGHNESS_M,
-        description="roughness height of the body's surface; OpenRocket's finishes: rough 5e-4, unfinished 1.5e-4, "
+        "roughness height of the body's surface; OpenRocket's finishes: rough 5e-4, unfinished 1.5e-4, "
         "regular paint 6e-5, smooth paint 2e-5, polished 2e-6",
     )
 
