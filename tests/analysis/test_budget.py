@@ -6,14 +6,13 @@ an IGRF sky), seven compilations, ~1 min each on a free core; the CLI test reuse
 ``runner.COMPILED_KEPT`` raised here)."""
 
 import json
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rocketmc.analysis.budget import SOURCES, BudgetError, budget, budget_rows, format_budget
-from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, runner, with_overrides
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, read_campaign_tables, runner, with_overrides
 from rocketmc.campaign.runner import run_chunks
 from rocketmc.cli import main
 
@@ -61,7 +60,7 @@ def test_none_row_is_every_sensor_truth_only(campaign, flown):
     """The 'none' row is the campaign whose file says ``truth_only = true`` in every sensor's table (the same
     resolved config: the same flights), and flies as the run path flies that config, bit for bit."""
     _, rows = flown
-    raw = tomllib.loads(CAMPAIGN.read_text())
+    raw = read_campaign_tables(CAMPAIGN)
     raw["n_realizations"] = N
     raw["avionics"].update({sensor: {"truth_only": True} for sensor in SENSORS})
     assert rows["none"].campaign.config.model_dump() == campaign_from_dict(raw, CAMPAIGNS).config.model_dump()
@@ -134,7 +133,7 @@ def test_cli_json_and_plot(flown, tmp_path, capsys):
 
 def test_idle_sources_without_flying(campaign):
     """A sensor whose errors are off already, or all zero, is reported as perfect; the rows are only built here."""
-    raw = tomllib.loads(CAMPAIGN.read_text())
+    raw = read_campaign_tables(CAMPAIGN)
     raw["n_realizations"] = N
     raw["avionics"]["gnss"] = {"truth_only": True}
     raw["avionics"]["magnetometer"] = {"noise_std": 0.0, "lsb": 0.0, "misalignment_deg": [0.0, 0.0, 0.0]}
@@ -180,7 +179,7 @@ ANOMALY = "environment.magnetic_field.anomaly_nt"
 def _field_variant(**filters) -> dict:
     """The campaign's file with an IGRF-14 truth (an anomaly of 50, 0, −20 nT, axes 0 and 2 dispersed by 200 nT) and
     ``filters`` as its [gnc.filters.attitude] (the file's: the thesis's dipole)."""
-    raw = tomllib.loads(CAMPAIGN.read_text())
+    raw = read_campaign_tables(CAMPAIGN)
     raw["n_realizations"] = N
     raw["environment"]["magnetic_field"] = {"model": "igrf", "date": "2021-09-13", "anomaly_nt": [50.0, 0.0, -20.0]}
     raw["gnc"]["filters"]["attitude"] = filters if filters else raw["gnc"]["filters"]["attitude"]
@@ -226,7 +225,7 @@ def test_field_model_source_without_flying(campaign):
 
 def test_magnetometer_soft_iron_spread_is_an_error(campaign):
     """A magnetometer whose only error is its soft-iron spread is not perfect."""
-    raw = tomllib.loads(CAMPAIGN.read_text())
+    raw = read_campaign_tables(CAMPAIGN)
     raw["n_realizations"] = N
     raw["avionics"]["magnetometer"] = {"noise_std": 0.0, "lsb": 0.0, "misalignment_deg": [0.0, 0.0, 0.0]}
     idle = SOURCES["magnetometer"].idle

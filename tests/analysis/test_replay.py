@@ -13,7 +13,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import shutil
-import tomllib
 from pathlib import Path
 
 import jax
@@ -25,7 +24,7 @@ import pytest
 from rocketmc.analysis import replay
 from rocketmc.analysis.flight_log import ROCCARASO_2021, read_pitot_static
 from rocketmc.analysis.sensor_log import LOG_FILES, read_sensor_log, write_sensor_log
-from rocketmc.campaign import campaign_from_dict, load_campaign
+from rocketmc.campaign import campaign_from_dict, load_campaign, read_campaign_tables
 from rocketmc.campaign.model import filter_params
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.campaign.sensor_record import _frames
@@ -34,6 +33,8 @@ from rocketmc.gnc.attitude_filter import attitude_error_b
 from rocketmc.gnc.navigation import bus_measurements, filter_step, initial_filters, liftoff_sensed
 from rocketmc.math import Quat, Vec3
 from rocketmc.sim.flight import fly
+
+from ..conftest import movable
 
 pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
 
@@ -47,7 +48,7 @@ GNSS_STD = (5.0, 0.5)  # m, m/s: the NEO-M9N's (1.7, 1.7, 3.4) m and (0.04, 0.04
 def flight():
     """The flight: its campaign, parameters, recorded bus (the flight's own view at each tick: the accelerometer's
     sample of the tick before) and truth at the log's ticks, the log's frames and liftoff tick."""
-    data = tomllib.loads(CAMPAIGN.read_text())
+    data = read_campaign_tables(CAMPAIGN)
     for section in ("gnc", "dispersions"):
         data.pop(section)
     data["environment"].pop("turbulence")
@@ -327,7 +328,7 @@ def test_navigate_refuses_what_it_cannot_replay(tmp_path, capsys):
     log = _real_log(tmp_path / "log")
     out = tmp_path / "nav.csv"
     pad = tmp_path / "pad.toml"
-    pad.write_text(CAMPAIGN.read_text().replace('navigation = "filters"', 'navigation = "truth"')
+    pad.write_text(movable(CAMPAIGN.read_text()).replace('navigation = "filters"', 'navigation = "truth"')
                    + '\n[gnc.filters]\ninitialisation = "pad"\n')  # fmt: skip
     _fails(capsys, ["navigate", str(log), "--site", str(pad), "--out", str(out)], "gnc.filters.initialisation")
     (log / LOG_FILES["gnss"][0]).unlink()

@@ -1,7 +1,7 @@
 """A campaign with every error source and every fault on: the campaign tests that compare bits (resume, Dask) fly it
 so that no draw, stream or set-up of the error sources can differ between chunks, processes or workers unseen.
 
-``every_error_source`` edits a shipped full-GNC campaign's text (lynx_nominal_gnc_1s, lynx_ballistic_gnc_1s): the
+``every_error_source`` edits a shipped full-GNC campaign's tables (lynx_nominal_gnc_1s, lynx_ballistic_gnc_1s): the
 truth in the IGRF-14 with a dispersed anomaly while the MEKF carries the dipole, the calibrated datasheet parts
 (BMX160, MS5803-01BA, NEO-M9N) with their per-flight spreads, hard- and soft-iron spreads, canard position sensors
 with errors, the filters initialised on the pad, the guidance reference derived at set-up, and every fault at
@@ -9,11 +9,14 @@ probability 0.5."""
 
 from __future__ import annotations
 
+import copy
+import tomllib
 from pathlib import Path
 
 import numpy as np
+import tomli_w
 
-from rocketmc.campaign import parse_campaign
+from rocketmc.campaign import campaign_from_dict, read_campaign_tables
 
 FAULT_KINDS = ("stuck_canard", "slow_canard", "gnss_outage", "magnetometer_step", "gyroscope_bias_jump",
                "accelerometer_bias_jump")  # fmt: skip
@@ -49,44 +52,42 @@ magnitude_mps2 = 0.5
 """
 """Every fault; the magnetometer's step may come on the pad, during the filters' pad samples (0 to 0.4 s)."""
 
-EDITS = [
+CALIBRATED_PARTS = {
+    "part": "bmx160", "accelerometer": {"cross_axis_std": 0.002},
+    "magnetometer": {"hard_iron_std": 3.0, "soft_iron_std": 0.02}, "barometer": {"part": "ms5803_01ba"},
+    "gnss": {"part": "neo_m9n"},
+    "canard_feedback": {"lsb": 0.1, "noise_std": 0.05, "bias_std": [0.2, 0.2, 0.2, 0.2], "scale_factor_std": 0.01},
+}  # fmt: skip
+"""The calibrated datasheet parts with hard- and soft-iron spreads and canard position sensors with errors."""
+
+
+def every_error_source(tables: dict) -> dict:
+    """``tables`` (a shipped full-GNC campaign's, the campaigns it extends merged: ``read_campaign_tables``) with every
+    error source and every fault on; each edit checks that it replaces what the base has."""
+    tables = copy.deepcopy(tables)
     # The truth in the IGRF-14 on the thesis's flight day with a crustal anomaly, dispersed per axis below; the MEKF
-    # keeps the dipole (the base's gnc.filters.attitude.field_model, checked below).
-    ('[environment.magnetic_field]\nmodel = "dipole"\n',
-     '[environment.magnetic_field]\nmodel = "igrf"\ndate = "2021-09-13"\nanomaly_nt = [300.0, -200.0, 100.0]\n'),
+    # keeps the dipole (the base's gnc.filters.attitude.field_model).
+    assert tables["environment"]["magnetic_field"] == {"model": "dipole"}
+    tables["environment"]["magnetic_field"] = {"model": "igrf", "date": "2021-09-13", "anomaly_nt": [300.0, -200.0, 100.0]}
+    tables["dispersions"].update({f"environment.magnetic_field.anomaly_nt.{i}": {"dist": "normal", "std": 100.0}
+                                  for i in range(3)})  # fmt: skip
     # The guidance reference derived from the campaign at set-up (in every process that loads it).
-    ("apogee_m = 1614.0\nflight_path_angle_deg = 84.0\nroll_heading_deg = 90.0\n", ""),
+    for key in ("apogee_m", "flight_path_angle_deg", "roll_heading_deg"):
+        del tables["gnc"]["guidance"][key]
     # TRIAD and the gyro's mean on the pad: 20 ticks (0.4 s) before Lynx's ignition at 0.5 s.
-    ('[gnc.filters.attitude]\nfield_model = "dipole"\n',
-     '[gnc.filters]\ninitialisation = "pad"\npad_samples = 20\n\n[gnc.filters.attitude]\nfield_model = "dipole"\n'),
-    ('[avionics]\npart = "thesis"\n',
-     '[avionics]\npart = "bmx160"\n\n'
-     "[avionics.accelerometer]\ncross_axis_std = 0.002\n\n"
-     "[avionics.magnetometer]\nhard_iron_std = 3.0\nsoft_iron_std = 0.02\n\n"
-     '[avionics.barometer]\npart = "ms5803_01ba"\n\n'
-     '[avionics.gnss]\npart = "neo_m9n"\n\n'
-     "[avionics.canard_feedback]\nlsb = 0.1\nnoise_std = 0.05\nbias_std = [0.2, 0.2, 0.2, 0.2]\n"
-     "scale_factor_std = 0.01\n"),
-    ("[dispersions]\n",
-     "[dispersions]\n" + "".join(f'"environment.magnetic_field.anomaly_nt.{i}" = {{ dist = "normal", std = 100.0 }}\n'
-                                 for i in range(3))),
-]  # fmt: skip
-
-
-def every_error_source(text: str) -> str:
-    """``text`` (a shipped full-GNC campaign) with every error source and every fault on; each edit replaces lines the
-    base has exactly once, so that no table is given twice."""
-    for old, new in EDITS:
-        assert text.count(old) == 1, old
-        text = text.replace(old, new)
-    return text + FAULTS
+    assert tables["gnc"]["filters"] == {"attitude": {"field_model": "dipole"}}
+    tables["gnc"]["filters"].update({"initialisation": "pad", "pad_samples": 20})
+    assert tables["avionics"] == {"part": "thesis"}
+    tables["avionics"] = copy.deepcopy(CALIBRATED_PARTS)
+    tables["faults"] = tomllib.loads(FAULTS)["faults"]
+    return tables
 
 
 def write_every_error_source(base: Path, folder: Path) -> Path:
-    """``base`` with every error source (``every_error_source``) as ``folder/<base's name>``, checked to load with each
-    source on."""
-    text = every_error_source(base.read_text())
-    config = parse_campaign(text, base.parent).config
+    """``base`` with every error source (``every_error_source``) written whole as ``folder/<base's name>``, checked to
+    load with each source on."""
+    tables = every_error_source(read_campaign_tables(base))
+    config = campaign_from_dict(tables, base.parent).config
     assert config.environment.magnetic_field.model == "igrf" and config.gnc.filters.attitude.field_model == "dipole"
     assert config.gnc.filters.initialisation == "pad" and config.gnc.guidance.apogee_m is None
     assert (config.avionics.part, config.avionics.barometer.part, config.avionics.gnss.part) == (
@@ -97,7 +98,7 @@ def write_every_error_source(base: Path, folder: Path) -> Path:
                "avionics.canard_feedback.bias.3", "avionics.accelerometer.cross_axis.5"}  # fmt: skip
     assert spreads <= set(config.dispersions), spreads - set(config.dispersions)
     path = folder / base.name
-    path.write_text(text)
+    path.write_text(tomli_w.dumps(tables))
     return path
 
 

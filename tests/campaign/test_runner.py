@@ -1,11 +1,12 @@
 """The runner: realization i is the same bits whatever the chunk size or device split."""
 
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from rocketmc.campaign import load_campaign, parse_campaign, run_chunks, runner, with_overrides
+from rocketmc.campaign import campaign_from_dict, load_campaign, read_campaign_tables, run_chunks, runner, with_overrides
 
 pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
 
@@ -53,10 +54,14 @@ def test_same_bits_for_any_chunk_size(name, sensors, other_chunk):
     # thesis's sensors, their walks and noise per block).
     path = CAMPAIGNS / f"{name}.toml"
     closed_loop = "ctrl" in name or "gnc" in name
-    text = path.read_text().replace("[dispersions]\n", SERVO_DISPERSIONS if closed_loop else "[dispersions]\n")
+    tables = read_campaign_tables(path)
+    if closed_loop:
+        tables["dispersions"].update(tomllib.loads(SERVO_DISPERSIONS)["dispersions"])
     if sensors:
-        text = text.replace('navigation = "truth"', 'navigation = "sensors"').replace("[dispersions]", SENSORS + "[dispersions]")
-    campaign = with_overrides(parse_campaign(text, path.parent), n_realizations=24)
+        assert tables["gnc"]["navigation"] == "truth"
+        tables["gnc"]["navigation"] = "sensors"
+        tables.update(tomllib.loads(SENSORS))
+    campaign = with_overrides(campaign_from_dict(tables, path.parent), n_realizations=24)
     a_out, a_in = collect(campaign, 5)
     b_out, b_in = collect(campaign, other_chunk)
     assert a_out.keys() == b_out.keys() and a_in.keys() == b_in.keys()

@@ -296,7 +296,7 @@ def test_broken_wind_profiles_name_the_field(tmp_path, content, words):
     ("rocket", "message_start"),
     [
         ({"preset": "lynx", "motor": {"thrust_curve": "x" * 10_000}}, "rocket.motor.thrust_curve: cannot look up 'xxx"),
-        ({"preset": "../rockets/lynx"}, "rocket.preset: unknown preset '../rockets/lynx' (available: lynx, lynx_2021)"),
+        ({"preset": "../rockets/lynx"}, "rocket.preset: unknown preset '../rockets/lynx' (available: lynx, lynx_2021, or a file name ending in .toml)"),
         ({"preset": "x" * 10_000}, "rocket.preset: unknown preset 'xxx"),
     ],
     ids=["long-file-name", "preset-path", "long-preset"],
