@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 from rocketmc.aero.canards import allocate
-from rocketmc.campaign import ConfigError, campaign_from_dict, with_overrides
+from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, with_overrides
 from rocketmc.campaign.limits import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS
 from rocketmc.campaign.loader import preset_rocket
 from rocketmc.campaign.fingerprint import data_digest
-from rocketmc.campaign.gains import plant_point
+from rocketmc.campaign.gains import plant_point, trim_angles_deg
 from rocketmc.campaign.model import airframe_params, nominal_params
 from rocketmc.gnc.design import (
     THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, flown_loop, lqi_gain, lqi_plant,
@@ -269,3 +269,13 @@ def test_no_climb_after_t0_is_refused():
     """t0 60 s after liftoff: the Lynx is past its apogee (~17 s) then, so no climb to derive."""
     with pytest.raises(ConfigError, match=r"^gnc.guidance.apogee_m: the nominal flight .* does not climb after t0_s"):
         campaign_from_dict(lynx("linear", gnc={"guidance": {"t0_s": 60.0}}), CAMPAIGNS)
+
+
+def test_canards_without_authority_are_refused():
+    """The thesis's Lynx trims |Cm_δ·δ_max/Cmα| = 21.8445 × 10° / 37.2959 = 5.857° (its linear model's own numbers:
+    the moment reference is the CG at burnout, so the same at every corner of the window, to rounding); with the
+    deflection limited to 0.08° it would trim 0.047°: one line naming the field."""
+    campaign = load_campaign(CAMPAIGNS / "lynx_ballistic_ctrl_1s.toml")
+    np.testing.assert_allclose(trim_angles_deg(campaign.config, campaign.gnc_inputs), 21.8445 * 10 / 37.2959, rtol=1e-9)
+    with pytest.raises(ConfigError, match=r"^gnc\.servo\.limit_deg: the canards at 0\.08° trim the rocket to 0\.047°"):
+        with_overrides(campaign, values={"gnc.servo.limit_deg": 0.08})

@@ -236,12 +236,42 @@ def check_coverage(config: CampaignConfig, inputs: DesignInputs) -> None:
             )
 
 
+MIN_TRIM_ANGLE_DEG = 0.5
+"""The least angle of attack the canards must hold the nominal rocket at with full deflection, everywhere in the
+guidance window, for a controller to be designed: the rail's setting error (0.5°, an inclinometer on a rail that
+sags), below which the canards correct less than the launch itself disperses. The Lynx trims 5.9° (its thesis's
+linear model), another team's 4-inch rocket with canards behind the nose (campaigns/custom_canards.toml) 3.5°."""
+
+
+def trim_angles_deg(config: CampaignConfig, inputs: DesignInputs) -> np.ndarray:
+    """The angle of attack [deg] the canards hold the nominal rocket at burnout at with full deflection
+    (gnc.servo.limit_deg), |Cm_δ·δ_max / Cmα| about its CG, at the corners of the nominal flight's speeds and
+    altitudes inside the guidance window."""
+    limit_rad = math.radians(config.gnc.servo.limit_deg)
+    points = [plant_point(inputs.aero, inputs.mass, speed, config.site.altitude_m + altitude, inputs.omega_a,
+                          inputs.atmosphere) for speed in inputs.speeds for altitude in inputs.altitudes_agl]  # fmt: skip
+    return np.degrees([abs(p.cm_delta * limit_rad / p.cm_alpha) for p in points])
+
+
+def check_authority(config: CampaignConfig, inputs: DesignInputs) -> None:
+    """ConfigError naming gnc.servo.limit_deg if the canards trim the rocket less than ``MIN_TRIM_ANGLE_DEG``
+    somewhere in the guidance window (``trim_angles_deg``)."""
+    weakest = float(np.min(trim_angles_deg(config, inputs)))
+    if weakest < MIN_TRIM_ANGLE_DEG:
+        raise ConfigError(f"gnc.servo.limit_deg: the canards at {config.gnc.servo.limit_deg:g}° trim the rocket to "
+                          f"{weakest:.2g}° of angle of attack where they are weakest in the guidance window, under the "
+                          f"{MIN_TRIM_ANGLE_DEG:g}° a controller needs: too little authority (larger canards, "
+                          "rocket.geometry.canards, or a larger deflection)")  # fmt: skip
+
+
 def design_schedule(config: CampaignConfig, inputs: DesignInputs) -> Schedule:
     """The campaign's gain schedule from its config and ``design_inputs``: speeds [m/s], altitudes [m above mean sea
     level] (the grid's altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming
-    the field if the grid does not cover the flight, a point has no stabilising design or its loop as flown (the
-    integrators stepped with gnc.guidance.integrator_gain) is not stable."""
+    the field if the grid does not cover the flight, the canards lack authority (``check_authority``), a point has no
+    stabilising design or its loop as flown (the integrators stepped with gnc.guidance.integrator_gain) is not
+    stable."""
     check_coverage(config, inputs)
+    check_authority(config, inputs)
     control = config.gnc.control
     try:
         # One BLAS thread: on 11×11 matrices more only contend (measured 2.5 ms a point against 7-25 ms
