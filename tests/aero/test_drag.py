@@ -327,6 +327,25 @@ def test_transitions_widening_narrowing_and_steps():
     assert drag_breakdown(same, 0.4, 0.0)["total"] == pytest.approx(drag_breakdown(BODY, 0.4, 0.0)["total"], rel=1e-12)
 
 
+def test_an_overridden_transition_flies_its_override():
+    """OpenRocket's drag override on a section (its "base drag hack": a cone from a point to the body's diameter
+    behind the tube, Cd 0): the section's friction and its own pressure drag, and the base it ends the body with, are
+    replaced by the given coefficient; the base of the step down in front of it is the tube's and stays. The point
+    cone behind BODY: friction loses the cone's wetted area exactly (rel 1e-12: the same friction coefficient,
+    areas in closed form), the base is the step's 0.12 on the whole section."""
+    cone = Transition(BODY.length_m, 0.3, 0.0, 0.1)
+    hacked = dataclasses.replace(BODY, length_m=BODY.length_m + 0.3, transitions=(dataclasses.replace(cone, cd_override=0.05),))
+    computed = dataclasses.replace(hacked, transitions=(cone,))
+    got, shape = drag_breakdown(hacked, 0.3, 0.0), drag_breakdown(computed, 0.3, 0.0)
+    cone_area = math.pi * 0.05 * math.hypot(0.3, 0.05)
+    body_area = nose_wetted_area_m2("ogive", 0.3, 0.05) + 2 * math.pi * 0.05 * 1.2 + cone_area
+    assert got["friction_body"] == pytest.approx(shape["friction_body"] * (1 - cone_area / body_area), rel=1e-12)
+    base_cd = 0.12 + 0.13 * 0.3**2
+    assert got["transition_pressure"] == pytest.approx(base_cd, rel=1e-12)  # the tube's base on the step to a point
+    assert shape["transition_pressure"] > got["transition_pressure"] and shape["base"] == pytest.approx(base_cd)
+    assert got["base"] == 0.0 and got["overrides"] == 0.05 and shape["overrides"] == 0.0
+
+
 def test_launch_lug_is_a_tube_in_axial_flow():
     """Niskanen 2009 §3.4.5: max(1.3 − l/d, 1) C_stag on π(r_o² − r_i² max(1 − l/d, 0)); C_stag = 0.85 at rest.
     rel 1e-12: closed form."""

@@ -370,6 +370,26 @@ def test_transitions_lugs_buttons_and_finishes_are_written(tmp_path):
     assert geometry.fins[0].profile == "square" and geometry.fins[0].surface_roughness_m == 60e-6  # "normal" default
 
 
+def test_a_transition_whose_drag_openrocket_overrides_keeps_it(tmp_path):
+    """OpenRocket's "base drag hack": a cone from a point to the body's diameter behind the tube, its drag
+    overridden to 0: written as a section with cd_override = 0 (not a boat-tail, not warned of), and the campaign
+    flies the override; a body tube's override is still warned of (rocketmc computes the body's drag whole)."""
+    hack = _component("transition", "Hack", f"{_material(PLASTIC)}<overridecd>0.0</overridecd><length>0.1</length>"
+                      f"<thickness>0.0001</thickness><shape>conical</shape><foreradius>0.00001</foreradius>"
+                      f"<aftradius>{R}</aftradius>")  # fmt: skip
+    ork = write_ork(tmp_path, design_xml(stage=nose() + body_tube() + hack))
+    design = read_design(ork)
+    ((name, section),) = design.transitions
+    assert name == "Hack" and section.cd_override == 0.0 and design.boat_tail is None
+    assert not any("drag override" in w for w in design.warnings)
+    result = import_openrocket(ork, tmp_path / "hack.toml")
+    (written,) = load_campaign(result.campaign).config.rocket.geometry.transitions
+    assert written.cd_override == 0.0
+    overridden_tube = body_tube().replace("<name>Body</name>", "<name>Body</name><overridecd>0.3</overridecd>")
+    assert any("'Body': its drag override" in w for w in read_design(write_ork(
+        tmp_path, design_xml(stage=nose() + overridden_tube), "tube.ork")).warnings)
+
+
 def test_a_bare_rocket_ork_xml_is_read_too(tmp_path):
     path = tmp_path / "rocket.ork"
     path.write_text(design_xml())

@@ -253,7 +253,8 @@ def _body_wetted_area_m2(geometry: RocketGeometry) -> float:
     for section in geometry.sections():
         area += 2 * np.pi * radius * (section.position_m - position)
         fore, aft = 0.5 * section.fore_diameter_m, 0.5 * section.aft_diameter_m
-        area += np.pi * (fore + aft) * math.hypot(section.length_m, fore - aft)
+        if section.cd_override is None:  # an overridden section's friction is in its override
+            area += np.pi * (fore + aft) * math.hypot(section.length_m, fore - aft)
         position, radius = section.position_m + section.length_m, aft
     return area + 2 * np.pi * radius * max(geometry.length_m - position, 0.0)
 
@@ -276,12 +277,17 @@ def _check(geometry: RocketGeometry):
 
 
 def _section_pressure(geometry: RocketGeometry, mach, base_cd) -> np.ndarray:
-    """Pressure drag [-] (ref S) of the conical sections and of the steps in front of them."""
+    """Pressure drag [-] (ref S) of the conical sections and of the steps in front of them; an overridden section
+    (``cd_override``) makes none of its own (the ring it adds in front included), the base of a step down before it
+    being the part ahead's."""
     total = np.zeros_like(mach)
     stagnation = stagnation_drag_coefficient(mach)
     for (_, before, fore_d), section in zip(geometry.step_diameters_m(), geometry.sections()):
         ring = np.pi / 4 * (fore_d**2 - before**2)  # > 0: a ring facing the flow, < 0: facing aft
-        total = total + (stagnation * ring if ring > 0 else base_cd * -ring)
+        if ring < 0 or section.cd_override is None:
+            total = total + (stagnation * ring if ring > 0 else base_cd * -ring)
+        if section.cd_override is not None:
+            continue
         aft_d = section.aft_diameter_m
         ring = np.pi / 4 * (aft_d**2 - fore_d**2)
         if aft_d < fore_d:
@@ -350,7 +356,11 @@ def _drag_components(geometry, mach, altitude_m, power_on, motor_diameter_m, bou
 
     base_cd = base_drag_coefficient(mach)
     radius, aft_radius = geometry.body_radius_m, 0.5 * geometry.aft_diameter_m
-    base_area = np.pi * aft_radius**2
+    sections = geometry.sections()
+    overrides = [s.cd_override for s in sections if s.cd_override is not None]
+    ends_overridden = bool(sections) and sections[-1].cd_override is not None \
+        and sections[-1].position_m + sections[-1].length_m >= geometry.length_m - 1e-6  # fmt: skip
+    base_area = 0.0 if ends_overridden else np.pi * aft_radius**2
     if power_on:  # the jet fills the base over the motor's cross-section
         motor_radius = aft_radius if motor_diameter_m is None else 0.5 * motor_diameter_m
         base_area = max(base_area - np.pi * motor_radius**2, 0.0)
@@ -370,6 +380,7 @@ def _drag_components(geometry, mach, altitude_m, power_on, motor_diameter_m, bou
         "launch_lugs": lug_drag_coefficient(geometry, mach),
         "rail_buttons": rail_button_drag_coefficient(geometry, mach, reynolds / length),
         "base": base_cd * base_area / s_ref,
+        "overrides": sum(overrides, zero),
     }
 
 
@@ -406,7 +417,7 @@ def drag_breakdown(
     """CD0 [-] of each component at one Mach and altitude [m], plus their sum under "total".
 
     Keys: friction_body, friction_fins, friction_canards, nose_pressure, fin_pressure,
-    canard_pressure, transition_pressure (the boat-tail's included), launch_lugs, rail_buttons, base,
+    canard_pressure, transition_pressure (the boat-tail's included), launch_lugs, rail_buttons, base, overrides,
     total; arguments as ``zero_lift_axial_coefficient``.
     """
     if np.ndim(mach) or np.ndim(altitude_m):

@@ -122,12 +122,15 @@ class BoatTail:
 @dataclasses.dataclass(frozen=True)
 class Transition:
     """Conical section from ``fore_diameter_m`` to ``aft_diameter_m`` over ``length_m``, its front
-    ``position_m`` from the nose tip [m]; narrowing or widening."""
+    ``position_m`` from the nose tip [m]; narrowing or widening. cd_override: a drag coefficient [-] on the
+    reference area flown instead of the section's own friction and pressure drag, and its base drag if it ends the
+    body (OpenRocket's component drag override; None: computed from the shape)."""
 
     position_m: float
     length_m: float
     fore_diameter_m: float
     aft_diameter_m: float
+    cd_override: float | None = None
 
     def __post_init__(self):
         if not self.length_m > 0:

@@ -355,7 +355,7 @@ class _Reader:
         if tag in ASSEMBLIES:
             return None
         self.parts += 1
-        if element.find("overridecd") is not None:
+        if element.find("overridecd") is not None and tag != "transition":
             self.warnings.append(f"component {name!r}: its drag override (Cd {element.findtext('overridecd')}) is not "
                                  "flown: rocketmc computes the drag of every component from its shape")  # fmt: skip
         if element.find("motormount") is not None:
@@ -638,8 +638,9 @@ class _Reader:
 
     def _profile(self) -> dict:
         """The body as rocketmc describes it: the nose, its base diameter, the aft narrowing transition as the
-        boat-tail, every other change of diameter (transitions, tubes of another diameter) as a conical section;
-        the body's roughness that of its largest surface."""
+        boat-tail, every other change of diameter (transitions, tubes of another diameter) as a conical section
+        (a transition whose drag OpenRocket overrides keeps the override); the body's roughness that of its largest
+        surface."""
         if not self.body or self.body[0][0] != "nosecone":
             raise OpenRocketError("the rocket does not start with a nose cone")
         nose_kind, nose_name, nose_element, nose_top, nose_length = self.body[0]
@@ -653,15 +654,19 @@ class _Reader:
             if kind == "transition" and (element.findtext("shape") or "conical").strip() != "conical":
                 self.warnings.append(f"transition {name!r}: a {element.findtext('shape')} transition flown as a "
                                      "conical one of the same length and diameters")  # fmt: skip
-            if kind == "transition" and i == len(self.body) - 1 and same and aft < fore and radius == body_radius:
+            overridden = kind == "transition" and element.find("overridecd") is not None
+            override = _number(element, "overridecd", name) if overridden else None
+            if kind == "transition" and i == len(self.body) - 1 and same and aft < fore and radius == body_radius \
+                    and override is None:  # fmt: skip
                 boat_tail = (name, length, 2 * aft, top)
             elif kind == "transition" or not same:
                 fore = radius if same else fore
-                transitions.append((name, Transition(top, length, 2 * fore, 2 * aft)))
+                transitions.append((name, Transition(top, length, 2 * fore, 2 * aft, override)))
             elif abs(radius - body_radius) < RADIUS_TOLERANCE_M:
                 names.append(name)
             radius = aft if kind == "transition" or not same else radius
-        areas = [(length * (sum(self._end_radii(e)) + 1e-12), e) for _, _, e, _, length in self.body]
+        areas = [(length * (sum(self._end_radii(e)) + 1e-12), e) for kind, _, e, _, length in self.body
+                 if not (kind == "transition" and e.find("overridecd") is not None)]  # its friction is in its override
         finishes = {(e.findtext("finish") or "normal").strip() for _, e in areas}
         largest = max(areas, key=lambda item: item[0])[1]
         if len(finishes) > 1:

@@ -317,7 +317,9 @@ def _geometry(toml: _Toml, design: Design) -> None:
     if design.transitions:
         toml.key("transitions", "[", "conical sections: OpenRocket's transitions and tubes of another diameter")
         for name, t in design.transitions:
-            toml.lines.append(f"    {_inline(position_m=t.position_m, length_m=t.length_m, fore_diameter_m=t.fore_diameter_m, aft_diameter_m=t.aft_diameter_m)},  # {_one_line(repr(name))}")
+            override = {} if t.cd_override is None else {"cd_override": t.cd_override}
+            toml.lines.append(f"    {_inline(position_m=t.position_m, length_m=t.length_m, fore_diameter_m=t.fore_diameter_m, aft_diameter_m=t.aft_diameter_m, **override)},  # {_one_line(repr(name))}"
+                              + (" (its drag overridden in OpenRocket)" if override else ""))
         toml.lines.append("]")
     for key, kind in (("launch_lugs", LaunchLug), ("rail_buttons", RailButton)):
         parts = [(name, part) for name, part in design.lug_shapes if isinstance(part, kind)]

@@ -248,6 +248,10 @@ class TransitionConfig(_Strict):
     length_m: Length = Field(description="along the axis")
     fore_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M, description="at its forward end")
     aft_diameter_m: float = Field(ge=0, le=MAX_DIAMETER_M, description="at its aft end")
+    cd_override: DragCoefficient | None = _added(
+        None, "a drag coefficient on the reference area flown instead of the section's friction and pressure drag "
+        "(and its base drag if it ends the body): OpenRocket's drag override; none: from its shape",
+    )
 
 
 class LaunchLugConfig(_Strict):
