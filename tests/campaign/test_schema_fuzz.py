@@ -354,7 +354,7 @@ def test_broken_aero_tables_name_the_field(tmp_path, name, words):
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[rocket.aero]\nmodel = "linear"\n\n[gnc.control]\n'
          "speeds_mps = [100.0, 300.0]", "gnc.control.speeds_mps"),
         ("chunk_size = 1000", 'chunk_size = 1000\n\n[rocket.aero]\nmodel = "linear"\nlinear.cn_delta = 0.0\n'
-         "linear.cm_delta = 0.0\n\n[gnc]", "gnc.control"),
+         "linear.cm_delta = 0.0\n\n[gnc]", "gnc.servo.limit_deg"),
         ("[dispersions]", '[dispersions]\n"gnc.control.r_weights.0" = { dist = "normal", std = 1.0 }',
          "dispersions.gnc.control.r_weights.0"),
         ("chunk_size = 1000", "chunk_size = 1000\n\n[gnc.servo]\noffset_deg = [0.0, 0.0, -10.5, 0.0]", "gnc.servo.offset_deg"),
@@ -588,11 +588,11 @@ def test_a_window_the_flight_misses_is_refused():
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")  # scipy, on the singular pencil
 def test_a_design_point_without_control_authority_is_refused():
-    """The schema's way to an unsolvable DARE: canards with no pitch and yaw authority (CN_δ = Cm_δ = 0).
-    The pitch and yaw integrators then sit on the unit circle at every point; the first one is named."""
+    """Canards with no pitch and yaw authority (CN_δ = Cm_δ = 0): they trim the rocket to 0°, refused before the
+    design (whose DARE has no stabilising solution then: the pitch and yaw integrators on the unit circle)."""
     raw = replaced(replaced(GNC, "rocket.aero.linear.cn_delta", 0.0), "rocket.aero.linear.cm_delta", 0.0)
     message = refusal(raw)
-    assert message.startswith("gnc.control: LQI design at speed 20 m/s, altitude 1416 m: no stabilising DARE"), message
+    assert message.startswith("gnc.servo.limit_deg: the canards at 10° trim the rocket to 0° of angle of attack"), message
 
 
 def test_gnc_needs_four_canards():
