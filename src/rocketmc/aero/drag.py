@@ -290,9 +290,10 @@ def _section_pressure(geometry: RocketGeometry, mach, base_cd) -> np.ndarray:
             continue
         aft_d = section.aft_diameter_m
         ring = np.pi / 4 * (aft_d**2 - fore_d**2)
-        if aft_d < fore_d:
-            height_ratio = section.length_m / (fore_d - aft_d)
-            total = total + base_cd * np.clip((3 - height_ratio) / 2, 0.0, 1.0) * -ring
+        if aft_d < fore_d:  # in radii, as the boat-tail's term has always been written: the same bits
+            fore_r, aft_r = 0.5 * fore_d, 0.5 * aft_d
+            height_ratio = section.length_m / (2 * (fore_r - aft_r))
+            total = total + base_cd * np.clip((3 - height_ratio) / 2, 0.0, 1.0) * np.pi * (fore_r**2 - aft_r**2)
         elif aft_d > fore_d:
             fineness = section.length_m / (aft_d - fore_d)
             total = total + nose_pressure_drag_coefficient("conical", fineness, mach) * ring
