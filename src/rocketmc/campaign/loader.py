@@ -26,14 +26,7 @@ from ..aero.io import load_aero
 from ..aero.model import LinearAero, TableAero, simplify
 from ..aero.sources import BUILTIN_TABLES, build_up_tables, power_on_axial_increment, with_axial_curve, with_canards
 from ..aero.tables import AeroTables
-from ..dynamics.motor_library import (
-    MotorEntry,
-    MotorLibraryError,
-    casing_inertia_kgm2,
-    estimated_grain,
-    find_motor,
-    read_eng_entry,
-)
+from ..dynamics.motor_library import MotorLibraryError, casing_inertia_kgm2, eng_header, estimated_grain, find_motor
 from ..dynamics.propulsion import ThrustCurveError, cumulative_impulse, read_thrust_curve
 from ..env.atmosphere import G0
 from ..env.weather import Weather, WeatherError, read_weather
@@ -358,7 +351,7 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
         inputs = design_inputs(config, airframe_params(config, time_s, thrust_n, aero, wind_profile, weather, nominal))
         schedule = design_schedule(config, inputs)
     return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, wind_profile, files, schedule, inputs,
-                    weather, motor=_eng_header(path))  # fmt: skip
+                    weather, motor=eng_header(path))  # fmt: skip
 
 
 def _with_library_motor(rocket: dict) -> dict:
@@ -405,17 +398,6 @@ def _check_specific_impulse(config: CampaignConfig, total_impulse_ns: float) -> 
     if motor.isp_s is not None and abs(curve_isp - motor.isp_s) > ISP_TOLERANCE * motor.isp_s:
         raise ConfigError(f"rocket.motor.isp_s: {motor.isp_s} s disagrees with the curve's impulse per "
                           f"propellant mass ({curve_isp:.1f} s) by more than {ISP_TOLERANCE:.0%}")  # fmt: skip
-
-
-def _eng_header(path: Path) -> MotorEntry | None:
-    """The motor a RASP ``.eng`` file's header describes, None for another kind of file or a header that is not
-    RASP's (the curve alone is read then)."""
-    if path.suffix.lower() != ".eng":
-        return None
-    try:
-        return read_eng_entry(path)
-    except MotorLibraryError:
-        return None
 
 
 def _check_elevation_unit(elevation_deg: float) -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..aero.geometry import LaunchLug, RailButton
-from ..dynamics.motor_library import MotorEntry, MotorLibraryError, find_motor
+from ..dynamics.motor_library import MotorEntry, MotorLibraryError, eng_header, find_motor
 from ..dynamics.propulsion import ThrustCurveError, read_thrust_curve
 from ..dynamics.rigid_body import MassProperties
 from ..files import replacing
@@ -204,13 +204,8 @@ def _motor_file(path: Path, sim: Simulation | None, source: Path) -> tuple[tuple
         text = path.read_text(encoding="utf-8-sig")
     except (ThrustCurveError, OSError, UnicodeDecodeError) as e:
         raise OpenRocketError(f"--motor {path}: {e}") from None
-    if path.suffix.lower() == ".eng":
-        header = next(line.split() for line in text.splitlines() if line.strip() and not line.lstrip().startswith(";"))
-        try:
-            propellant, total = float(header[4]), float(header[5])
-            return (propellant, max(total - propellant, 0.0), f"{path.name}'s RASP header"), text
-        except (IndexError, ValueError):
-            pass
+    if (header := eng_header(path)) is not None:
+        return (header.propellant_mass_kg, header.casing_mass_kg, f"{path.name}'s RASP header"), text
     if sim is not None and "Time" in sim.columns:
         return _stored_masses(sim), text
     raise OpenRocketError(f"--motor {path}: no propellant mass (neither a RASP header with it nor a stored "

@@ -126,6 +126,17 @@ def read_eng_entry(path: str | Path) -> MotorEntry:
                       float(cumulative_impulse(time_s, thrust_n)[-1]), burn_time_s(time_s, thrust_n))  # fmt: skip
 
 
+def eng_header(path: Path) -> MotorEntry | None:
+    """The motor a thrust file's RASP header describes (``read_eng_entry``); None for another kind of file, or an
+    ``.eng`` whose first line is not a RASP header (its curve alone is read then)."""
+    if path.suffix.lower() != ".eng":
+        return None
+    try:
+        return read_eng_entry(path)
+    except MotorLibraryError:
+        return None
+
+
 @functools.cache
 def motor_library() -> tuple[MotorEntry, ...]:
     """Every motor of the built-in library, by file name."""
