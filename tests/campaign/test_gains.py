@@ -20,7 +20,7 @@ from rocketmc.campaign import ConfigError, campaign_from_dict, load_campaign, wi
 from rocketmc.campaign.limits import DEFAULT_ALTITUDES_M, DEFAULT_SPEEDS_MPS
 from rocketmc.campaign.loader import preset_rocket
 from rocketmc.campaign.fingerprint import data_digest
-from rocketmc.campaign.gains import plant_point, trim_angles_deg
+from rocketmc.campaign.gains import design_grid, plant_point, trim_angles_deg
 from rocketmc.campaign.model import airframe_params, nominal_params
 from rocketmc.gnc.design import (
     THESIS_Q, THESIS_R, PlantPoint, augment, density, discretise, flown_loop, lqi_gain, lqi_plant,
@@ -208,6 +208,27 @@ def test_window_estimate_of_lynx(linear):
     inputs = linear.gnc_inputs
     np.testing.assert_allclose(inputs.speeds, (62.0, 183.3), rtol=0.01)
     np.testing.assert_allclose(inputs.altitudes_agl, (31.2, 1223.6), atol=5.0)
+
+
+def test_default_grid_grows_to_a_faster_rocket(linear):
+    """The Lynx's window lies inside the default grid, which it keeps point for point. The same Lynx on 2.2× the
+    thrust (148-405 m/s and 72-2646 m above the pad in the window) is designed on the defaults grown by 50 m/s
+    and 1000 m until they cover it (it was refused naming the grid before); a grid set in the campaign is not grown."""
+    assert design_grid(linear.config, linear.gnc_inputs) == {"speeds_mps": DEFAULT_SPEEDS_MPS,
+                                                             "altitudes_m": DEFAULT_ALTITUDES_M}  # fmt: skip
+    raw = lynx("linear")
+    raw["rocket"]["motor"] = {**raw["rocket"].get("motor", {}), "thrust_scale": 2.2}
+    del raw["dispersions"]["rocket.motor.thrust_scale"]
+    fast = campaign_from_dict(raw, CAMPAIGNS)
+    assert fast.gnc_inputs.speeds[1] > DEFAULT_SPEEDS_MPS[-1] and fast.gnc_inputs.altitudes_agl[1] > 2000.0
+    grid = design_grid(fast.config, fast.gnc_inputs)
+    assert grid == {"speeds_mps": [*DEFAULT_SPEEDS_MPS, 350.0, 400.0, 450.0], "altitudes_m": [*DEFAULT_ALTITUDES_M, 3000.0]}
+    np.testing.assert_array_equal(fast.gnc_schedule.speeds, grid["speeds_mps"])
+    assert fast.gnc_schedule.gains.shape == (13, 4, 3, 11)
+    slow_start = fast.gnc_inputs._replace(speeds=(12.7, 200.0))
+    assert design_grid(fast.config, slow_start)["speeds_mps"][:2] == [12.0, 20.0]
+    with pytest.raises(ConfigError, match=r"^gnc\.control\.speeds_mps: the grid spans 20 to 300 m/s, the nominal flight 148"):
+        campaign_from_dict({**raw, "gnc": {"control": {"speeds_mps": DEFAULT_SPEEDS_MPS}}}, CAMPAIGNS)
 
 
 def test_gains_are_in_the_fingerprint(linear):

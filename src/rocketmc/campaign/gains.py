@@ -220,20 +220,35 @@ def describe_reference(reference: GuidanceReference) -> str:
             f"({mark('roll_heading_deg')})")  # fmt: skip
 
 
-def check_coverage(config: CampaignConfig, inputs: DesignInputs) -> None:
-    """ConfigError unless the design grid covers the estimated flight inside the guidance window (an
-    altitude grid of one point designs gains for every altitude)."""
-    control, guidance = config.gnc.control, config.gnc.guidance
-    grids = [("speeds_mps", control.speeds_mps, inputs.speeds, "m/s")]
-    if len(control.altitudes_m) > 1:
-        grids.append(("altitudes_m", control.altitudes_m, inputs.altitudes_agl, "m above the pad"))
-    for name, grid, (low, high), unit in grids:
-        if not (grid[0] <= low and high <= grid[-1]):
+GRID_STEPS = {"speeds_mps": 50.0, "altitudes_m": 1000.0}
+"""The steps [m/s, m] by which a default design grid grows past its last point to cover a rocket's nominal flight."""
+
+
+def design_grid(config: CampaignConfig, inputs: DesignInputs) -> dict[str, list[float]]:
+    """gnc.control's speeds_mps [m/s] and altitudes_m [m above the pad] as designed on: each as set in the campaign,
+    or, left at its default, the default grown by ``GRID_STEPS`` (and a speed point below it, the window's lowest
+    speed rounded down) until it covers the nominal flight's window, so that another rocket gets a grid around its
+    own flight; the Lynx's window lies inside the defaults. ConfigError if a grid set in the campaign does not cover
+    the window (an altitude grid of one point designs gains for every altitude)."""
+    control = config.gnc.control
+    window = {"speeds_mps": (inputs.speeds, "m/s"), "altitudes_m": (inputs.altitudes_agl, "m above the pad")}
+    grids = {}
+    for name, ((low, high), unit) in window.items():
+        grid = list(getattr(control, name))
+        if name not in control.model_fields_set:
+            if low < grid[0]:
+                grid.insert(0, max(math.floor(low), 1.0))
+            while grid[-1] < high:
+                grid.append(grid[-1] + GRID_STEPS[name])
+        elif (name == "speeds_mps" or len(grid) > 1) and not (grid[0] <= low and high <= grid[-1]):
+            guidance = config.gnc.guidance
             raise ConfigError(
                 f"gnc.control.{name}: the grid spans {grid[0]:g} to {grid[-1]:g} {unit}, the nominal flight "
                 f"{low:.0f} to {high:.0f} {unit} in the guidance window ({guidance.window_start_s:g} to "
                 f"{guidance.window_end_s:g} s after liftoff; a point-mass estimate): extend the grid"
             )
+        grids[name] = grid
+    return grids
 
 
 MIN_TRIM_ANGLE_DEG = 0.5
@@ -267,10 +282,10 @@ def check_authority(config: CampaignConfig, inputs: DesignInputs) -> None:
 def design_schedule(config: CampaignConfig, inputs: DesignInputs) -> Schedule:
     """The campaign's gain schedule from its config and ``design_inputs``: speeds [m/s], altitudes [m above mean sea
     level] (the grid's altitudes_m plus site.altitude_m), gains (speed, altitude, 3, 11). ConfigError naming
-    the field if the grid does not cover the flight, the canards lack authority (``check_authority``), a point has no
+    the field if a grid set in the campaign does not cover the flight (``design_grid``), the canards lack authority (``check_authority``), a point has no
     stabilising design or its loop as flown (the integrators stepped with gnc.guidance.integrator_gain) is not
     stable."""
-    check_coverage(config, inputs)
+    grid = design_grid(config, inputs)
     check_authority(config, inputs)
     control = config.gnc.control
     try:
@@ -280,8 +295,8 @@ def design_schedule(config: CampaignConfig, inputs: DesignInputs) -> Schedule:
             return gain_schedule(
                 lambda speed, altitude: plant_point(inputs.aero, inputs.mass, speed, altitude, inputs.omega_a,
                                                     inputs.atmosphere),
-                control.speeds_mps,
-                config.site.altitude_m + np.asarray(control.altitudes_m),
+                grid["speeds_mps"],
+                config.site.altitude_m + np.asarray(grid["altitudes_m"]),
                 dt=config.simulation.control_dt_s,
                 q=np.diag(control.q_weights),
                 r=np.diag(control.r_weights),
@@ -309,9 +324,10 @@ def schedule_summary(config: CampaignConfig, schedule: Schedule, inputs: DesignI
     spectral radius and the loop's as flown (``gnc.design.flown_loop``), relative Riccati residual, K (3, 11)
     and its ``MAIN_GAINS``; the guidance reference, each value with whether it was derived (t0_s is always set)."""
     control = config.gnc.control
+    altitudes_agl = design_grid(config, inputs)["altitudes_m"]
     points = [
         {
-            "speed_mps": float(speed), "altitude_agl_m": control.altitudes_m[j],
+            "speed_mps": float(speed), "altitude_agl_m": altitudes_agl[j],
             "altitude_msl_m": float(altitude), "spectral_radius": float(schedule.spectral_radius[i, j]),
             "flown_spectral_radius": float(schedule.flown_radius[i, j]),
             "riccati_residual": float(schedule.residual[i, j]), "gain": schedule.gains[i, j].tolist(),

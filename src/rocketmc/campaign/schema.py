@@ -681,10 +681,10 @@ class ControlConfig(_Strict):
         [100.0, 100.0, 100.0], min_length=3, max_length=3, description="R's diagonal on the (yaw, pitch, roll) commands"
     )
     speeds_mps: list[Annotated[float, Field(gt=0, le=MAX_SPEED_MPS)]] = Field(
-        DEFAULT_SPEEDS_MPS, min_length=2, description="axial speeds of the design grid, increasing"
+        DEFAULT_SPEEDS_MPS, min_length=2, description="axial speeds of the design grid, increasing (left out: these, grown to cover the nominal flight)"
     )
     altitudes_m: list[Annotated[float, Field(ge=0, le=MAX_ALTITUDE_M)]] = Field(
-        DEFAULT_ALTITUDES_M, min_length=1, description="heights above the pad of the design grid, increasing"
+        DEFAULT_ALTITUDES_M, min_length=1, description="heights above the pad of the design grid, increasing (left out: these, grown to cover the nominal flight)"
     )
     discretisation: Literal["zoh", "euler"] = Field("zoh", description="how the plant is discretised over control_dt_s")
     anti_windup: bool = Field(True, description="conditional integration after a clipped command")
