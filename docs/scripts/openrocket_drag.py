@@ -6,7 +6,9 @@ Imports each design of FOLDER that rocketmc flies (``rocketmc import``, its firs
 compares OpenRocket's stored "Drag coefficient" over the coast (burnout to apogee, motor off, angle of attack below
 5°) with ``aero.drag.zero_lift_axial_coefficient`` of the imported geometry at the same Mach number and altitude,
 both on OpenRocket's reference area (its largest body cross-section). Prints both at a few Mach numbers with
-OpenRocket's friction, pressure and base parts beside the build-up's, and draws Cd(Mach) per design.
+OpenRocket's friction, pressure and base parts beside the build-up's, and draws Cd(Mach) per design; then
+OpenRocket's stored centre of pressure over the coast beside the build-up's (``aero.buildup.normal_force_slope``),
+both from the nose tip.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from rocketmc.aero.buildup import normal_force_slope
 from rocketmc.aero.drag import drag_breakdown, zero_lift_axial_coefficient
 from rocketmc.campaign import load_campaign
 from rocketmc.campaign.loader import rocket_geometry
@@ -52,7 +55,8 @@ def coast(design_path: Path, folder: Path) -> dict | None:
     parts = {name: c[f"{name} drag coefficient"][keep][order] for name in ("Friction", "Pressure", "Base")}
     return {"name": design_path.stem, "motor": design.motor_mount(sim.config_id).designation, "geometry": geometry,
             "scale": scale, "mach": c["Mach number"][keep][order], "altitude": c["Altitude"][keep][order],
-            "cd": c["Drag coefficient"][keep][order], "parts": parts}  # fmt: skip
+            "cd": c["Drag coefficient"][keep][order], "parts": parts, "cp": c["CP location"][keep][order],
+            "reference_length": float(c["Reference length"][0])}  # fmt: skip
 
 
 def ours_parts(row: dict, mach: float, altitude: float) -> dict[str, float]:
@@ -82,6 +86,14 @@ def main() -> None:
             print(f"| {row['name']} ({row['motor']}) | {mach:g} | {cd:.3f} ({theirs['Friction']:.3f} + "
                   f"{theirs['Pressure']:.3f} + {theirs['Base']:.3f}) | {ours['total']:.3f} ({ours['Friction']:.3f} + "
                   f"{ours['Pressure']:.3f} + {ours['Base']:.3f}) |")  # fmt: skip
+    print("\n| design | Mach | OpenRocket CP [m from the tip] | rocketmc CP | difference [calibers] |")
+    print("|---|---|---|---|---|")
+    for row in rows:
+        mach = float(np.median(row["mach"]))
+        theirs = float(np.interp(mach, row["mach"], row["cp"]))
+        ours = float(normal_force_slope(row["geometry"], mach)[1])
+        print(f"| {row['name']} | {mach:.2f} | {theirs:.3f} | {ours:.3f} | "
+              f"{(ours - theirs) / row['reference_length']:+.2f} |")  # fmt: skip
     figure = Figure(figsize=(7, 4.5), layout="constrained")
     ax = figure.subplots()
     for i, row in enumerate(rows):
