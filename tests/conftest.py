@@ -20,6 +20,8 @@ from pathlib import Path
 _SESSION_CACHE = "JAX_COMPILATION_CACHE_DIR" not in os.environ
 if _SESSION_CACHE:
     os.environ["JAX_COMPILATION_CACHE_DIR"] = tempfile.mkdtemp(prefix="rocketmc-tests-jax-cache-")
+    # rocketmc's exported programs likewise (runtime.CACHE_DIR), not the user's cache folder
+    os.environ["ROCKETMC_CACHE_DIR"] = os.path.join(os.environ["JAX_COMPILATION_CACHE_DIR"], "rocketmc")
 
 import jax  # noqa: E402
 import pytest

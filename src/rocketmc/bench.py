@@ -216,10 +216,14 @@ def _one_core():
         os.sched_setaffinity(0, cores)
 
 
-def _subprocess(precision: str, **spec) -> dict:
+def _subprocess(precision: str, cache: str | None = None, **spec) -> dict:
     """``_measure(spec)`` in a fresh process with ``ROCKETMC_PRECISION=precision``; ``costs`` on one core
-    with ``ONE_THREAD_XLA_FLAGS``."""
+    with ``ONE_THREAD_XLA_FLAGS``; ``cache``: its folder of compiled programs (``runtime.CACHE_DIR``, XLA's
+    executables in it too), by default the user's."""
     env = {**os.environ, "ROCKETMC_PRECISION": precision}
+    if cache is not None:
+        env["ROCKETMC_CACHE_DIR"] = cache
+        env.pop("JAX_COMPILATION_CACHE_DIR", None)
     one_core = spec["kind"] == "costs"
     if one_core:
         env["XLA_FLAGS"] = ONE_THREAD_XLA_FLAGS
@@ -291,16 +295,24 @@ def run_benchmarks(
     compared = (min(sizes), models[0]) if set(PRECISIONS) <= set(precisions) else None
     with tempfile.TemporaryDirectory() as tmp:
         impacts = {p: str(Path(tmp) / f"{p}.npz") for p in PRECISIONS}
+        cache = str(Path(tmp) / "cache")  # empty: each (model, precision)'s first process compiles cold
         for n in sizes:
             for model in models:
                 for precision in precisions:
                     same = (n, model) == compared
                     r = {"model": model, "n": n, "float32_draws": same and precision == "float64"}
-                    r |= _subprocess(precision, kind="throughput", campaign=path, chunk_size=chunk_size,
+                    r |= _subprocess(precision, cache, kind="throughput", campaign=path, chunk_size=chunk_size,
                                      impacts=impacts[precision] if same else None, **r)  # fmt: skip
                     report["measurements"].append(r)
                     log(f"{model} {precision} N = {n}: compile {r['compile_s']:.1f} s, {r['flights_per_s']:.0f} "
                         f"flights/s, {r['ok']} ok, peak RSS {r['peak_rss_mb']:.0f} MB")  # fmt: skip
+        first = report["measurements"][0]
+        warm = _subprocess(precisions[0], cache, kind="throughput", campaign=path, chunk_size=chunk_size,
+                           impacts=None, model=models[0], n=sizes[0], float32_draws=first["float32_draws"])  # fmt: skip
+        report["compile_s"] = {"model": models[0], "precision": precisions[0], "n": sizes[0],
+                               "cold": first["compile_s"], "warm": warm["compile_s"]}  # fmt: skip
+        log(f"compile ({models[0]}, {precisions[0]}): {first['compile_s']:.1f} s cold, {warm['compile_s']:.1f} s warm "
+            "(a fresh process, the program from the disk cache)")  # fmt: skip
         if compared:
             c = _impact_difference(impacts["float64"], impacts["float32"])
             report["float32_vs_float64"] = {"n": compared[0], "model": compared[1], **c}
@@ -337,6 +349,10 @@ def format_report(report: dict) -> str:
         lines.append(f"  {r['model']:<13}{r['precision']:<10}{r['n']:>8}{r['chunk_size']:>7}{r['compile_s']:>11.1f}"
                      f"{r['run_s']:>9.1f}{r['flights_per_s']:>11.1f}{r['ok']:>8}{r['peak_rss_mb']:>13.0f}"
                      f"  {failed}")  # fmt: skip
+    c = report["compile_s"]
+    lines.append(f"  compile ({c['model']}, {c['precision']}, N = {c['n']}): {c['cold']:.1f} s cold (empty cache), "
+                 f"{c['warm']:.1f} s warm (a fresh process, the program from the disk cache); later rows of a model "
+                 "and precision are warm")  # fmt: skip
     rate = {(r["model"], r["precision"], r["n"]): r["flights_per_s"] for r in rows}
     lines += [f"  interpolated / simplified cost per flight ({p}, N = {n}, separate runs): "
               f"{rate['simplified', p, n] / fps:.2f}x"

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rocketmc.campaign import campaign_from_dict, load_campaign, read_campaign_tables, run_chunks, runner, with_overrides
+from rocketmc.campaign import campaign_from_dict, read_campaign_tables, run_chunks, with_overrides
 
 pytestmark = pytest.mark.slow  # campaigns or long flights: left out by make test-fast
 
@@ -77,20 +77,3 @@ def test_same_bits_for_any_chunk_size(name, sensors, other_chunk):
         assert len(np.unique(a_out["attitude_error_rms_window_rad"])) == 24
     if sensors:  # the drawn turn-on biases are inputs, one per axis
         assert len(np.unique(a_in["avionics.gyroscope.bias.2"])) == 24 and "avionics.canard_feedback.bias.3" in a_in
-
-
-def test_one_program_for_every_n_and_seed(monkeypatch):
-    """N and the seed are not in the chunk program (the indices and the master key are its arguments): the lowered
-    programs of two runs that differ only in them are the same text, so a process compiles once for both and JAX's
-    disk cache, keyed by that text, serves the next process; another number is another program."""
-    campaign = load_campaign(CAMPAIGNS / "lynx_ballistic.toml")
-    other_n_and_seed = with_overrides(campaign, n_realizations=37, seed=campaign.config.seed + 1)
-    heavier = with_overrides(campaign, values={"rocket.dry_mass_kg": campaign.config.rocket.dry_mass_kg + 1.0})
-    assert runner.lower_chunk(campaign, 16).as_text() == runner.lower_chunk(other_n_and_seed, 16).as_text()
-    assert runner.lower_chunk(campaign, 16).as_text() != runner.lower_chunk(heavier, 16).as_text()
-    compiled = []
-    monkeypatch.setattr(runner, "compile_chunk", lambda c, batch: compiled.append(c) or object())
-    monkeypatch.setattr(runner, "_compiled", runner.OrderedDict())
-    assert runner.compiled_chunk(campaign, 16) is runner.compiled_chunk(other_n_and_seed, 16)
-    assert runner.compiled_chunk(heavier, 16) is not runner.compiled_chunk(campaign, 16)
-    assert compiled == [campaign, heavier]

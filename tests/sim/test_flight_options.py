@@ -179,7 +179,7 @@ def test_burn_time_reshapes_the_curve_keeping_its_impulse():
     time is T and the total impulse (× thrust_scale) is the curve's; a dispersed burn time does so per flight."""
     campaign = campaign_from_dict(NOMINAL)
     curve_t, curve_f = campaign.thrust_time_s, campaign.thrust_n
-    impulse = cumulative_impulse(curve_t, curve_f)[-1]
+    impulse = float(cumulative_impulse(curve_t, curve_f)[-1])
     motor = {**NOMINAL["rocket"].get("motor", {}), "burn_time_s": 4.0}
     raw = {**with_rocket(motor=motor), "dispersions": {**NOMINAL["dispersions"],
                                                        "rocket.motor.burn_time_s": {"dist": "uniform", "low": 2.0, "high": 5.0}}}  # fmt: skip

@@ -55,13 +55,6 @@ def setup(campaign: Campaign, chunk_size: int | None = None) -> dict:
     }
 
 
-def program_fingerprint(campaign: Campaign) -> str:
-    """The fingerprint of what a compiled chunk function is built from: the set-up of its flights with N and the seed
-    left out (the realizations' indices and the master key are its arguments; ``runner.lower_chunk``)."""
-    flights = setup(campaign)
-    return fingerprint({**flights, "config": {**flights["config"], "n_realizations": None, "seed": None}})
-
-
 def fingerprint(setup: dict) -> str:
     """SHA-256 of a ``setup`` dict (canonical JSON: sorted keys, no spaces)."""
     return hashlib.sha256(json.dumps(setup, sort_keys=True, separators=(",", ":")).encode()).hexdigest()

@@ -12,7 +12,7 @@ there: the gust and canard deflections of the period starting at that instant, i
 periods are the flight's own (``control_dt_s``, longer in steady descent under canopy). Positions along the rocket
 (CG, centre of pressure) are distances from the nose tip [m], angles in degrees, everything else SI.
 
-Every recorded flight is compiled once per campaign set-up and kind (``compiled_flight``), kept per process.
+Every recorded flight is compiled once per campaign structure and kind (``compiled_flight``), kept per process.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from ..sim.flight import flight_done, fly, initial_state, period_gust
 from ..sim.loads import derivatives, loads
 from ..sim.outputs import DEPLOY_TIME_SUFFIX, Metric, flight_summary
 from .record import Campaign
-from .fingerprint import fingerprint, setup
+from .program import cached_program, program_numbers, structure_fingerprint, with_numbers
 from .model import flight_params, nominal_params
 from .runner import LANES, realization_params, sim_settings
 from .sampling import realization_key
@@ -86,38 +86,46 @@ _compiled: dict = {}
 """The one compiled recorded flight a process keeps: each holds ~15 000 periods' buffers."""
 
 
-def compiled_flight(campaign: Campaign, kind: Hashable, build: Callable[[], Callable]) -> Callable:
-    """``jax.jit(build())``, kept per process by the campaign's set-up fingerprint and ``kind`` (what is recorded,
-    how); one at a time."""
-    key = fingerprint(setup(campaign)), kind
-    if key not in _compiled:
-        _compiled.clear()
-        _compiled[key] = jax.jit(build())
-    return _compiled[key]
+def compiled_flight(campaign: Campaign, kind: Hashable, build: Callable[[Campaign], Callable]) -> Callable:
+    """``build(campaign)`` with the campaign's numbers as arguments (``program.with_numbers``), exported into the cache
+    folder by the campaign's structure (``program.structure_fingerprint``), ``kind`` (what is recorded, how) and the
+    arguments' shapes (``program.cached_program``), and kept compiled per process, one at a time: the function of
+    ``build``'s arguments, the campaign's numbers bound."""
+    key, numbers = (structure_fingerprint(campaign), repr(kind)), program_numbers(campaign)
+
+    def run(*args):
+        if _compiled.get("key") != key:
+            _compiled.clear()
+            function = jax.jit(lambda numbers, *args: build(with_numbers(campaign, numbers))(*args))
+            _compiled.update(key=key, run=cached_program("flight", "".join(key), function, numbers, *args).compiled(
+                numbers, *args))  # fmt: skip
+        return _compiled["run"](numbers, *args)
+
+    return run
 
 
 def _flight_function(campaign: Campaign, nominal: bool):
-    """The compiled flight: index -> (samples, end-of-period powers, per-period summaries, statuses, done flags),
-    kept per campaign set-up."""
+    """The recorded flight: (index, the master key's data) -> (samples, end-of-period powers, per-period summaries,
+    statuses, done flags)."""
     settings = sim_settings(campaign)
     longest = math.ceil(settings.max_time_s / settings.control_dt_s)  # periods last at least control_dt_s
     n_periods = -(-longest // settings.block_steps) * settings.block_steps
-    master = jax.random.key(campaign.config.seed)
 
-    def params_of(index):
+    def params_of(index, master):
         if nominal:  # ``campaign.nominal_params``, with the index traced as the runner's
             return flight_params(campaign, campaign.nominal, realization_key(master, index))
         return realization_params(campaign, master, index)[0]
 
-    def lane(index):
-        p = params_of(index)
+    def lane(index, master):
+        p = params_of(index, master)
         record = lambda s: (_kept(s), *flight_summary(p, s), flight_done(settings, s))  # noqa: E731
         return fly(p, settings, n_periods, record=record)[1]
 
-    def flown(index):
+    def flown(index, key_data):
+        master = jax.random.wrap_key_data(key_data)
         states, summaries, statuses, done = jax.tree_util.tree_map(
-            lambda x: x[0], jax.vmap(lane)(jnp.full(LANES, index, dtype=jnp.uint32)))  # fmt: skip
-        p = params_of(index)
+            lambda x: x[0], jax.vmap(lane, in_axes=(0, None))(jnp.full(LANES, index, dtype=jnp.uint32), master))  # fmt: skip
+        p = params_of(index, master)
         states = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), _kept(initial_state(p)), states)
         first = jax.tree_util.tree_map(lambda x: x[:-1], states)
         then = jax.tree_util.tree_map(lambda x: x[1:], states)
@@ -166,9 +174,10 @@ def flight_record(campaign: Campaign, realization: int | None = None) -> FlightR
     outside the campaign."""
     check_realization(campaign, realization)
     nominal = realization is None
-    run = compiled_flight(campaign, ("record", nominal), lambda: _flight_function(campaign, nominal))
+    run = compiled_flight(campaign, ("record", nominal), lambda flying: _flight_function(flying, nominal))
+    master = jax.random.key_data(jax.random.key(campaign.config.seed))
     states, samples, power_end, summaries, statuses, done, jumps = jax.tree_util.tree_map(
-        np.asarray, run(np.uint32(realization or 0)))  # fmt: skip
+        np.asarray, run(np.uint32(realization or 0), master))  # fmt: skip
     steps = sim_settings(campaign).block_steps
     block_ends = np.arange(steps - 1, len(done), steps)
     end = block_ends[np.argmax(done[block_ends])]  # the runner's last block
@@ -305,7 +314,7 @@ def simulated_flight(campaign: Campaign, duration_s: float = 150.0) -> tuple[pd.
         force, mach = jax.vmap(at)(trajectory)
         return final, trajectory, force, mach
 
-    final, trajectory, force, mach = compiled_flight(campaign, ("sensed", n_periods), lambda: sensed)(params)
+    final, trajectory, force, mach = compiled_flight(campaign, ("sensed", n_periods), lambda _: sensed)(params)
     summary, status = flight_summary(params, final)
     altitude = -np.asarray(trajectory.body.r_n.z)
     speed_of_sound = np.asarray(isa(float(params.environment.site_altitude_m) + altitude).speed_of_sound)

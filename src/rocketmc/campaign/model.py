@@ -49,6 +49,15 @@ def _vector(values: Mapping, path: str, n: int, suffix: str = ""):
     return jnp.stack([jnp.asarray(values[f"{path}.{i}{suffix}"], dtype=float) for i in range(n)])
 
 
+def _configured(config: CampaignConfig, path: str) -> float:
+    """The number the config holds at a dotted path: a host float, also where the flight's values are traced (what
+    is switched off by a zero is decided from it; ``program.structure_fingerprint`` keeps its sign)."""
+    node = config
+    for part in path.split("."):
+        node = node[int(part)] if part.isdigit() else getattr(node, part)
+    return float(node)
+
+
 def _arrays(values: Mapping) -> dict:
     return {k: jnp.asarray(x, dtype=float) for k, x in values.items()}
 
@@ -109,7 +118,7 @@ def _rocket(cfg: CampaignConfig, thrust_time_s, thrust_n, table_aero: TableAero 
     motor_dry_x = grain_center if cfg.rocket.motor.dry_cg_m is None else body_x(f"{m}.dry_cg_m")
     time_s, scaled_thrust_n = jnp.asarray(thrust_time_s), jnp.asarray(thrust_n) * v[f"{m}.thrust_scale"]
     if cfg.rocket.motor.burn_time_s is not None:  # the curve reshaped to the burn time, each segment's impulse kept
-        stretch = v[f"{m}.burn_time_s"] / float(thrust_time_s[-1])
+        stretch = v[f"{m}.burn_time_s"] / time_s[-1]
         time_s, scaled_thrust_n = time_s * stretch, scaled_thrust_n / stretch
     motor = Motor(
         time_s=time_s,
@@ -243,10 +252,11 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
     guidance = guidance_params(gnc.guidance, campaign.gnc_inputs.reference)  # the reference: set, or derived
     schedule = campaign.gnc_schedule
     gains = schedule.gains.reshape(*schedule.gains.shape[:2], -1)  # (speed, altitude, 33)
-    if schedule.altitudes.size > 1:
-        table = Table.from_numpy((schedule.speeds, schedule.altitudes), gains, ("speed", "altitude"), GAIN_NAMES)
+    if schedule.altitudes.size > 1:  # the design's grid, checked when it was designed (traced in a program)
+        table = Table((jnp.asarray(schedule.speeds), jnp.asarray(schedule.altitudes)), jnp.asarray(gains),
+                      ("speed", "altitude"), GAIN_NAMES)  # fmt: skip
     else:
-        table = Table.from_numpy((schedule.speeds,), gains[:, 0], ("speed",), GAIN_NAMES)
+        table = Table((jnp.asarray(schedule.speeds),), jnp.asarray(gains[:, 0]), ("speed",), GAIN_NAMES)
     navigation = NavigationMode(gnc.navigation)
     filters = filter_params(campaign) if navigation is NavigationMode.FILTERS else None
     rail = (None, None) if navigation is NavigationMode.TRUTH else nominal_rail(campaign)
@@ -255,7 +265,7 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
 
 def guidance_params(g: GuidanceConfig, reference: GuidanceReference) -> GuidanceParams:
     """Guidance from [gnc.guidance] and the reference it steers to (``campaign.gains.guidance_reference``), in SI."""
-    rad = lambda deg: jnp.asarray(math.radians(deg))  # noqa: E731
+    rad = lambda deg: jnp.deg2rad(jnp.asarray(deg, dtype=float))  # noqa: E731
     return GuidanceParams(
         apogee_m=jnp.asarray(reference.apogee_m), t0_s=jnp.asarray(g.t0_s),
         flight_path_angle_rad=rad(reference.flight_path_angle_deg), heading_rad=rad(reference.heading_deg),
@@ -340,7 +350,7 @@ def _channel(campaign: Campaign, v: Mapping, sensor: str) -> Channel:
     path, unit, n = f"avionics.{sensor}", SENSOR_UNITS[sensor], len(c.bias)
 
     def drawn(field: str) -> bool:  # not zero in some flight: an error that is zero in all costs nothing (None)
-        return campaign.nominal[f"{path}.{field}"] != 0.0 or f"{path}.{field}" in config.dispersions
+        return _configured(config, f"{path}.{field}") != 0.0 or f"{path}.{field}" in config.dispersions
 
     rate, density = c.rate_hz, c.noise_density is not None
     white = noise_per_sample(v[f"{path}.noise_density"], rate) if density else v[f"{path}.noise_std"]
@@ -418,7 +428,7 @@ def _true_field(campaign: Campaign, v: Mapping) -> tuple:
         else:
             field_t, gradient = _igrf(config)
     field_t = jnp.asarray(field_t)
-    if any(campaign.nominal[f"{f}.{i}"] != 0.0 or f"{f}.{i}" in config.dispersions for i in range(3)):
+    if any(_configured(config, f"{f}.{i}") != 0.0 or f"{f}.{i}" in config.dispersions for i in range(3)):
         field_t = field_t + 1e-9 * _vector(v, f, 3)
     return field_t, None if gradient is None else jnp.asarray(gradient)
 

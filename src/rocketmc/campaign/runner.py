@@ -29,7 +29,7 @@ from ..sim.outputs import flight_summary
 from ..sim.params import FlightParams
 from ..sim.params import SimSettings
 from .record import Campaign
-from .fingerprint import program_fingerprint
+from .program import Program, cached_program, program_numbers, structure_fingerprint, with_numbers
 from .model import flight_params
 from .sampling import realization_key, sample_dispersions, sample_faults
 
@@ -67,10 +67,20 @@ device's next one (``simulate_queue``). Measured on the 2-core machine, whole 10
 491-494); a kernel's fixed cost is spread over twice the lanes (docs/performance.md)."""
 
 
+SHARED_BATCH_FLIGHTS = 1000
+"""The default chunk size: smaller chunks (a run of fewer flights) are rounded up to a power of two of SIMD vectors
+per device, at most this many flights' worth, so that runs of one campaign with other small N share programs
+(16, 32, ..., 512 and 1008 flights on two cores)."""
+
+
 def batch_size(chunk_size: int) -> int:
-    """Flights per compiled batch: ``chunk_size`` rounded up to ``LANES`` per local device."""
+    """Flights per compiled batch: ``chunk_size`` rounded up to ``LANES`` per local device, and below
+    ``SHARED_BATCH_FLIGHTS`` to a power of two of those (at most the default chunk's batch)."""
     multiple = LANES * jax.local_device_count()
-    return -(-chunk_size // multiple) * multiple
+    vectors, shared = -(-chunk_size // multiple), -(-SHARED_BATCH_FLIGHTS // multiple)
+    if vectors < shared:
+        vectors = min(1 << (vectors - 1).bit_length(), shared)
+    return vectors * multiple
 
 
 def simulate_queue(params_of: Callable[[jnp.ndarray], FlightParams], queue, settings: SimSettings, lanes: int):
@@ -115,50 +125,73 @@ def simulate_queue(params_of: Callable[[jnp.ndarray], FlightParams], queue, sett
     return carry[4], carry[5]
 
 
-def lower_chunk(campaign: Campaign, batch: int) -> jax.stages.Lowered:
-    """The chunk function, lowered: (master_key, indices (batch,)) -> (summary, status, inputs). N and the seed are
-    not in it (the indices and the master key are arguments): one program serves every N and seed.
-
-    The batch (a ``batch_size``) is split evenly over the local devices (the CPU cores, see
-    ``rocketmc.__init__``) with ``shard_map``; each device flies its share on ``GROUP`` lanes and
-    stops when its own flights are done.
-    """
+def chunk_function(campaign: Campaign) -> Callable:
+    """The jitted chunk function of the campaign's structure (``program.structure_fingerprint``): (numbers, the master
+    key's data, indices (batch,)) -> (summary, status, inputs), the numbers ``program.program_numbers``'. The batch
+    is split evenly over the local devices (the CPU cores, see ``rocketmc.__init__``) with ``shard_map``; each device
+    flies its share on ``GROUP`` lanes and stops when its own flights are done."""
     settings = sim_settings(campaign)
 
-    def chunk(master_key, indices):
-        drawn = jax.vmap(lambda i: realization_params(campaign, master_key, i)[1])(indices)
-        params_of = lambda i: realization_params(campaign, master_key, i)[0]  # noqa: E731
+    def chunk(numbers, key_data, indices):
+        flying, master_key = with_numbers(campaign, numbers), jax.random.wrap_key_data(key_data)
+        drawn = jax.vmap(lambda i: realization_params(flying, master_key, i)[1])(indices)
+        params_of = lambda i: realization_params(flying, master_key, i)[0]  # noqa: E731
         return *simulate_queue(params_of, indices, settings, GROUP), drawn
 
-    mesh = jax.sharding.Mesh(np.array(jax.local_devices()), ("batch",))
+    P, mesh = jax.sharding.PartitionSpec, jax.sharding.Mesh(np.array(jax.local_devices()), ("batch",))
+    return jax.jit(jax.shard_map(chunk, mesh=mesh, in_specs=(P(), P(), P("batch")), out_specs=P("batch"),
+                                 check_vma=False))  # fmt: skip
+
+
+def _chunk_program(campaign: Campaign, batch: int) -> Program:
+    """``chunk_function`` exported once per structure, batch and device count into the cache folder
+    (``program.cached_program``), and jitted from that export whether it was made now or read back."""
     P = jax.sharding.PartitionSpec
-    sharded = jax.shard_map(chunk, mesh=mesh, in_specs=(P(), P("batch")), out_specs=P("batch"), check_vma=False)
-    return jax.jit(sharded).lower(jax.random.key(0), jnp.zeros(batch, dtype=jnp.uint32))
+    return cached_program("chunk", structure_fingerprint(campaign), chunk_function(campaign),
+                          *_example_arguments(campaign, batch), in_specs=(P(), P(), P("batch")), out_spec=P("batch"))  # fmt: skip
+
+
+def _example_arguments(campaign: Campaign, batch: int) -> tuple:
+    return program_numbers(campaign), jax.random.key_data(jax.random.key(0)), np.zeros(batch, dtype=np.uint32)
+
+
+def lower_chunk(campaign: Campaign, batch: int) -> jax.stages.Lowered:
+    """The chunk program for a batch (a ``batch_size``), lowered: its arguments are the campaign's numbers, the master
+    key's data and the indices (batch,), so N, the seed and every number ``program.program_numbers`` carries are not
+    in it: one program serves every campaign of the same structure (``chunk_function``)."""
+    return _chunk_program(campaign, batch).lower(*_example_arguments(campaign, batch))
+
+
+def _bound(compiled: Callable, campaign: Campaign) -> Callable:
+    """``compiled`` with the campaign's numbers bound: (master_key, indices) -> (summary, status, inputs)."""
+    numbers = program_numbers(campaign)
+    return lambda master_key, indices: compiled(numbers, jax.random.key_data(master_key), indices)
 
 
 def compile_chunk(campaign: Campaign, batch: int) -> Callable:
-    """``lower_chunk(campaign, batch)`` compiled."""
-    return lower_chunk(campaign, batch).compile()
+    """``lower_chunk(campaign, batch)`` compiled, the campaign's numbers bound: (master_key, indices) -> (summary,
+    status, inputs)."""
+    return _bound(_chunk_program(campaign, batch).compiled(*_example_arguments(campaign, batch)), campaign)
 
 
 COMPILED_KEPT = 4
-"""Compiled chunk functions a process keeps (the most recently used): a Dask worker's successive
-chunks and runs, a notebook's or a test's runs of one campaign, compile once."""
+"""Compiled chunk programs a process keeps (the most recently used): a Dask worker's successive
+chunks and runs, a notebook's or a test's runs of campaigns of one structure, compile once."""
 
 _compiled: OrderedDict[tuple[str, int], Callable] = OrderedDict()
 _compile_lock = threading.Lock()
 
 
 def compiled_chunk(campaign: Campaign, batch: int) -> Callable:
-    """``compile_chunk(campaign, batch)``, kept per process by the program's fingerprint (the set-up without N and
-    the seed) and the batch; one compilation at a time, whatever the process's threads."""
-    key = program_fingerprint(campaign), batch
+    """``compile_chunk(campaign, batch)``, its program kept per process by the campaign's structure
+    (``program.structure_fingerprint``) and the batch; one compilation at a time, whatever the process's threads."""
+    key = structure_fingerprint(campaign), batch
     with _compile_lock:
-        compiled = _compiled.pop(key, None) or compile_chunk(campaign, batch)
+        compiled = _compiled.pop(key, None) or _chunk_program(campaign, batch).compiled(*_example_arguments(campaign, batch))
         _compiled[key] = compiled  # the most recently used last
         while len(_compiled) > COMPILED_KEPT:
             _compiled.popitem(last=False)
-    return compiled
+    return _bound(compiled, campaign)
 
 
 @dataclass

@@ -52,7 +52,7 @@ def sensor_record(campaign: Campaign, realization: int = 0, static_s: float | No
         params = dataclasses.replace(params, rocket=dataclasses.replace(params.rocket, motor=motor))
     n_periods = math.ceil((config.simulation.max_time_s if static_s is None else static_s) / dt)
     record = lambda s: (s.avionics.bus, s.body.v_n.norm() > 0.0)  # noqa: E731
-    flown = compiled_flight(campaign, ("sensor log", n_periods), lambda: lambda p: fly(p, settings, n_periods, record=record))
+    flown = compiled_flight(campaign, ("sensor log", n_periods), lambda _: lambda p: fly(p, settings, n_periods, record=record))
     final, (bus, moving) = flown(params)
     t = np.arange(n_periods) * dt  # each period's start: its samples' time
     keep = np.ones(n_periods, bool)

@@ -126,8 +126,8 @@ def read_thrust_curve(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def cumulative_impulse(time_s: np.ndarray, thrust_n: np.ndarray) -> np.ndarray:
-    """Trapezoidal cumulative impulse at each curve point (exact for the linear curve) [N·s]."""
-    return np.concatenate([[0.0], np.cumsum(np.diff(time_s) * 0.5 * (thrust_n[1:] + thrust_n[:-1]))])
+    """Trapezoidal cumulative impulse at each curve point (exact for the linear curve) [N·s]; traceable."""
+    return jnp.concatenate([jnp.zeros(1), jnp.cumsum(jnp.diff(time_s) * 0.5 * (thrust_n[1:] + thrust_n[:-1]))])
 
 
 def thrust(motor: Motor, t):
