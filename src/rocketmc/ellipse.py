@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy.stats import bootstrap, chi2
 
 
 def chi2_scale(level: float) -> float:
@@ -15,6 +14,8 @@ def chi2_scale(level: float) -> float:
     """
     if not 0.0 < level < 1.0:
         raise ValueError(f"confidence level must lie strictly between 0 and 1, got {level}")
+    from scipy.stats import chi2  # here, not at import: scipy.stats takes ~0.6 s before a run's first flight
+
     return float(chi2.ppf(level, df=2))
 
 
@@ -136,6 +137,8 @@ def percentile_interval(samples, statistic, paired: bool = True, confidence: flo
     """Percentile-bootstrap interval (``scipy.stats.bootstrap``) of ``statistic(*samples, axis=-1)``,
     vectorised, at ``confidence``: each sample's last axis (its points) resampled, with the same indices
     for all samples when ``paired``, independently otherwise."""
+    from scipy.stats import bootstrap  # as in ``chi2_scale``
+
     result = bootstrap(samples, statistic, paired=paired, vectorized=True, axis=-1, confidence_level=confidence,
                        n_resamples=n_resamples, method="percentile", random_state=seed)  # fmt: skip
     return float(result.confidence_interval.low), float(result.confidence_interval.high)
