@@ -30,10 +30,10 @@ import numpy as np
 import pytest
 
 import ppigrf
-from ppigrf.ppigrf import shc_fn_igrf13
+from ppigrf.ppigrf import shc_fn_igrf13, shc_fn_igrf14
 
 from rocketmc.env.magnetic import (
-    IGRF14_TABLE, DipoleCoefficients, _ned_axes, dipole_field_ned, first_order_field, igrf_dipole,
+    IGRF14_TABLE, IGRF14_VALIDITY, DipoleCoefficients, _ned_axes, dipole_field_ned, first_order_field, igrf_dipole,
     igrf_site_field_gradient, igrf_validity, site_field_gradient, site_field_ned,
 )
 from rocketmc.math import Vec3
@@ -349,7 +349,8 @@ def test_igrf_to_first_order_over_the_flights_region(site):
 
 
 def test_igrf_dates():
-    assert igrf_validity() == (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1))
+    assert IGRF14_TABLE == shc_fn_igrf14  # found without importing ppigrf: the same file
+    assert igrf_validity() == IGRF14_VALIDITY == (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1))
     for day in (datetime.date(1899, 12, 31), datetime.date(2030, 1, 2)):
         with pytest.raises(ValueError, match=rf"{day.isoformat()}.*1900-01-01 to 2030-01-01"):
             igrf_site_field_gradient(*THESIS_SITE, day)

@@ -10,7 +10,6 @@ from __future__ import annotations
 from importlib import resources
 
 import numpy as np
-import scipy.io
 
 from ..math.table import Table
 
@@ -34,6 +33,8 @@ def load_datcom_mat(path) -> Table:
     ``State`` holds Alphas [deg], Machs, Betas [deg], Altitudes [m]; each ``Coeffs`` field is an
     array (alpha, mach, beta, altitude). Raises ``DatcomFileError`` naming the file and what is missing.
     """
+    import scipy.io  # here, not at import: ~0.08 s before the first flight of a campaign without DATCOM tables
+
     try:
         with open(path, "rb") as file:
             mat = scipy.io.loadmat(file, squeeze_me=True, struct_as_record=False)

@@ -21,11 +21,11 @@ import dataclasses
 import math
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-import pandas as pd
 
 from ..aero.stability import centre_of_pressure_at
 from ..dynamics.servo import deflection_at
@@ -40,6 +40,10 @@ from .program import cached_program, program_numbers, structure_fingerprint, wit
 from .model import flight_params, nominal_params
 from .runner import LANES, realization_params, sim_settings
 from .sampling import realization_key
+
+if TYPE_CHECKING:  # imported where a frame is made: pandas takes ~0.2 s, before a run's first flight
+    import pandas as pd
+
 
 def _kept(state):
     """The part of a ``FlightState`` the record keeps: all but the sensors' and the navigation filters' state."""
@@ -249,6 +253,8 @@ def _series(campaign: Campaign, states, samples, summary) -> tuple[pd.DataFrame,
         for a, name in zip("xyz", ("p", "q", "r")):
             columns[f"integrator_{name}"] = (deg(getattr(states.gnc.integrators, a)), "deg",
                                              f"LQI rate-error integrator e_{name}")  # fmt: skip
+    import pandas as pd
+
     frame = pd.DataFrame({name: np.asarray(v[0], dtype=float) for name, v in columns.items()})
     frame["phase"] = _phases(campaign, frame["time"].to_numpy(), summary)
     units = {name: Metric(unit, meaning) for name, (_, unit, meaning) in columns.items()}
@@ -318,6 +324,8 @@ def simulated_flight(campaign: Campaign, duration_s: float = 150.0) -> tuple[pd.
     summary, status = flight_summary(params, final)
     altitude = -np.asarray(trajectory.body.r_n.z)
     speed_of_sound = np.asarray(isa(float(params.environment.site_altitude_m) + altitude).speed_of_sound)
+    import pandas as pd
+
     flight = pd.DataFrame({
         "t_s": np.asarray(trajectory.t) - ignition,
         "altitude_agl_m": altitude,

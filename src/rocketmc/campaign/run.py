@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 from ..errors import RocketmcError
@@ -41,7 +42,7 @@ def _silent(line: str, transient: bool = False) -> None:
 
 
 def _warn(line: str) -> None:
-    warnings.warn(" ".join(line.split()), RunWarning, stacklevel=4)  # the caller of run_campaign
+    warnings.warn(" ".join(line.split()), RunWarning, stacklevel=5)  # the caller of run_campaign
 
 
 def kept_trajectories(campaign: Campaign, realizations: Sequence[int]) -> list[int]:
@@ -93,11 +94,18 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
 def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_converged_pct: float | None,
          kept: list[int], interval_s: float, progress: Callable[..., None], warn: Callable[[str], None]) -> Path:  # fmt: skip
     """``run_campaign``'s loop once its writer holds the partial folder."""
+    with ThreadPoolExecutor(1) as pool:  # the pre-flight checks beside the compilation, which leaves a core idle
+        checks = pool.submit(preflight_warnings, campaign)
+        return _fly_checked(campaign, writer, executor, until_converged_pct, kept, interval_s, progress, warn, checks)
+
+
+def _fly_checked(campaign: Campaign, writer: ResultWriter, executor: Callable, until_converged_pct: float | None,
+                 kept: list[int], interval_s: float, progress: Callable[..., None], warn: Callable[[str], None],
+                 checks: Future) -> Path:  # fmt: skip
+    """``_fly`` with the pre-flight warnings ``checks`` will give: warned once the chunks have compiled (or when
+    there is nothing to fly), before the first flight."""
     cfg = campaign.config
     chunk_size, n_chunks = writer.chunk_size, writer.n_chunks
-    campaign_warnings = preflight_warnings(campaign)
-    for line in campaign_warnings:
-        warn(line)
     done = set(writer.completed_chunks())
     todo = [c for c in range(n_chunks) if c not in done]
     progress(f"{cfg.name}: {cfg.n_realizations} realizations, seed {cfg.seed}, {n_chunks} chunk(s) of {chunk_size}"
@@ -111,10 +119,14 @@ def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_con
     if convergence is not None:
         for index in sorted(done):
             convergence.add(writer.chunk_outputs(index, ("status", "impact_north_m", "impact_east_m")))
-    if todo and not (convergence and convergence.check()):
-        runs = executor(campaign, chunk_size, chunks=todo)
-        try:
-            progress(f"compiled in {next(runs):.1f} s")
+    runs = executor(campaign, chunk_size, chunks=todo) if todo and not (convergence and convergence.check()) else None
+    try:
+        compile_s = None if runs is None else next(runs)
+        campaign_warnings = checks.result()
+        for line in campaign_warnings:
+            warn(line)
+        if runs is not None:
+            progress(f"compiled in {compile_s:.1f} s")
             for i, (index, chunk) in enumerate(zip(todo, runs)):
                 writer.write(chunk, index)
                 flown, seconds = flown + len(chunk.outputs["status"]), seconds + chunk.seconds
@@ -126,11 +138,12 @@ def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_con
                     convergence.add(chunk.outputs)
                     if convergence.check():
                         break
-        except KeyboardInterrupt:
-            progress(f"interrupted: the chunks finished are kept in {writer.dir}; the same command with --resume "
-                     "completes the run")  # fmt: skip
-            raise
-        finally:
+    except KeyboardInterrupt:
+        progress(f"interrupted: the chunks finished are kept in {writer.dir}; the same command with --resume "
+                 "completes the run")  # fmt: skip
+        raise
+    finally:
+        if runs is not None:
             runs.close()  # a cluster's chunks still in flight are cancelled
     n_rows = None
     if convergence is not None:

@@ -11,7 +11,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from ..aero.geometry import DEFAULT_ROUGHNESS_M, FIN_PROFILES, NOSE_KINDS
-from ..env.magnetic import igrf_validity
+from ..env.magnetic import IGRF14_VALIDITY
 from ..env.wind import POWER_LAW_FLOOR_M
 from ..sensors.parts import load_part, part_names
 from .errors import shown
@@ -541,7 +541,7 @@ class MagneticFieldConfig(_Strict):
             day = date.fromisoformat(text)
         except ValueError:
             raise ValueError("expected an ISO 8601 date, e.g. '2025-09-18'") from None
-        first, last = igrf_validity()
+        first, last = IGRF14_VALIDITY
         if not first <= day <= last:
             raise ValueError(f"the IGRF-14 covers {first.isoformat()} to {last.isoformat()}, got {text}")
         return text

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import datetime
 import functools
+import importlib.util
+import os
 import tomllib
 from importlib import resources
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-from ppigrf.ppigrf import geod2geoc, igrf_gc, read_shc, shc_fn_igrf14
 
 from ..math import Vec3
 from ..pytree import pytree_dataclass
@@ -113,9 +114,13 @@ def site_field_gradient(latitude_deg, longitude_deg, altitude_m, decimal_year: f
     return np.asarray(field_t(origin), dtype=float), np.asarray(jax.jacfwd(field_t)(origin), dtype=float)
 
 
-IGRF14_TABLE = shc_fn_igrf14
-"""ppigrf's IGRF-14 coefficient table (.shc): main-field models every 5 years 1900.0–2025.0 and 2030.0, the 2025.0
+IGRF14_TABLE = os.path.join(importlib.util.find_spec("ppigrf").submodule_search_locations[0], "IGRF14.shc")
+"""ppigrf's IGRF-14 coefficient table (.shc; its ``shc_fn_igrf14``, found without importing ppigrf, which imports pandas:
+~0.2 s before a run's first flight, needed only with a magnetometer): main-field models every 5 years 1900.0–2025.0 and 2030.0, the 2025.0
 model moved by the predictive secular variation (data/igrf/SOURCE.md)."""
+IGRF14_VALIDITY = (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1))
+"""``igrf_validity`` of ``IGRF14_TABLE``, known without reading it (tests/env/test_magnetic.py reads it): the campaign's
+date check needs no ppigrf."""
 GRADIENT_STEP_M = 25.0
 """The half step [m] of the gradient's central differences. Their truncation, h²/6 of the field's third derivative,
 is ≈ 3.3 (h/r)² of the gradient for the dominant dipole (B ∝ r⁻³): 8e-14 h² [m⁻²]; ppigrf's rounding, ~1e-15 of |B|
@@ -126,6 +131,7 @@ of a dipole table, tests/env/test_magnetic.py). Their sum is least, ~1e-10 of th
 @functools.cache
 def igrf_validity(table: str = IGRF14_TABLE) -> tuple[datetime.date, datetime.date]:
     """The first and last dates of a coefficient table (IGRF-14: 1900-01-01 to 2030-01-01)."""
+    from ppigrf.ppigrf import read_shc
     g, _ = read_shc(table)
     return g.index[0].date(), g.index[-1].date()
 
@@ -133,6 +139,7 @@ def igrf_validity(table: str = IGRF14_TABLE) -> tuple[datetime.date, datetime.da
 def _igrf_in_axes(points_m: np.ndarray, date: datetime.date, table: str, axes: np.ndarray) -> np.ndarray:
     """ppigrf's field [nT] (n, 3) at Earth-centred points [m] (n, 3) (x to 0° E on the equator, z north) at 0 h UTC
     of ``date``, in the axes whose rows (in Earth-centred axes) are ``axes`` (3, 3)."""
+    from ppigrf.ppigrf import igrf_gc
     radius = np.linalg.norm(points_m, axis=1)
     theta, phi = np.arccos(points_m[:, 2] / radius), np.arctan2(points_m[:, 1], points_m[:, 0])
     at = datetime.datetime(date.year, date.month, date.day)
@@ -153,6 +160,8 @@ def igrf_site_field_gradient(latitude_deg, longitude_deg, altitude_m, date: date
     ±``GRADIENT_STEP_M`` along the site's axes, each point's field turned into them. The site goes onto Earth-centred
     axes by ppigrf's ``geod2geoc``, its altitude taken above the ellipsoid (the geoid is within ~100 m of it: ~2 nT).
     ValueError outside the table's dates. ~0.03 s; cached (read-only arrays)."""
+    from ppigrf.ppigrf import geod2geoc
+
     first, last = igrf_validity(table)
     if not first <= date <= last:
         raise ValueError(f"IGRF: the date {date.isoformat()} is outside the model's {first.isoformat()} to "

@@ -17,7 +17,6 @@ from typing import NamedTuple
 
 import h5py
 import numpy as np
-import scipy.io
 
 from .atmosphere import G0, R_EARTH_GEOPOTENTIAL
 from .wind import read_csv_columns
@@ -214,6 +213,8 @@ def _text(value) -> str:
 
 def _netcdf_variables(path: Path, classic: bool) -> dict[str, _Variable]:
     """The variables of NETCDF_NAMES found in the file, by their key there."""
+    import scipy.io  # here, not at import: ~0.08 s before the first flight of a campaign without a weather file
+
     wanted = {name: key for key, names in NETCDF_NAMES.items() for name in names}
     found = {}
     try:
