@@ -8,7 +8,8 @@
   core); in another, on one core and one thread, the costs per flight: the interpolated
   aerodynamics against the simplified, the closed loop (perfect navigation) against the
   same flights with the controller off, the closed loop on raw sensors against it, the full
-  GNC (navigation filters) against the controller off (their bounds: docs/performance.md).
+  GNC (navigation filters) against the controller off (their bounds: docs/performance.md);
+- the control periods per flight by phase (ascent, after apogee at the control period, the long descent ones).
 
 Each measurement runs in a fresh Python process (``python -m rocketmc.bench SPEC``): its peak
 resident memory (``ru_maxrss``, compilation included) is its own, and ``ROCKETMC_PRECISION`` (read
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import platform
 import resource
@@ -38,8 +40,9 @@ import numpy as np
 from .runtime import PRECISION
 from .ellipse import confidence_ellipse
 from .campaign import load_campaign, run_chunks, with_overrides
-from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, sim_settings
-from .sim.state import Status
+from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, realization_params, sim_settings
+from .sim.flight import fly
+from .sim.state import Status, done
 
 DEFAULT_CAMPAIGN = Path(str(resources.files("rocketmc") / "data" / "campaigns" / "lynx_nominal.toml"))
 MODELS = ("simplified", "interpolated")
@@ -132,6 +135,36 @@ def costs(campaign, repeats: int = 3) -> dict:
             "full_gnc_speed_over_open_loop": s["simplified"] / s["filters"]}  # fmt: skip
 
 
+PHASE_FLIGHTS = 32
+"""Realizations whose control periods ``periods_by_phase`` counts."""
+
+
+def periods_by_phase(campaign, repeats: int | None = None) -> dict:
+    """Control periods per flight, median over ``PHASE_FLIGHTS`` realizations (``repeats`` unused: nothing is timed):
+    in all, in the ascent (to apogee), after apogee at ``control_dt_s`` (the canopies' openings and settling, wind-layer
+    boundaries) and in the longer steady-descent periods, each with its median seconds of flight."""
+    settings = sim_settings(campaign)
+    master = jax.random.key(campaign.config.seed)
+    n_periods = math.ceil(settings.max_time_s / settings.control_dt_s)
+
+    def periods(index):
+        p, _ = realization_params(campaign, master, index)
+        record = lambda s: (s.t, jnp.isfinite(s.events.apogee_time), done(s))  # noqa: E731
+        return fly(p, settings, n_periods, record=record)[1]
+
+    indices = jnp.arange(PHASE_FLIGHTS, dtype=jnp.uint32)
+    t, past_apogee, landed = map(np.asarray, jax.jit(jax.vmap(periods))(indices))
+    length = np.diff(t, axis=1, prepend=0.0)
+    flying = ~np.concatenate([np.zeros((PHASE_FLIGHTS, 1), bool), landed[:, :-1]], axis=1)  # the landing one counts
+    regular = np.isclose(length, settings.control_dt_s) | (length < settings.control_dt_s)
+    phases = {"ascent": flying & ~past_apogee, "after_apogee_regular": flying & past_apogee & regular,
+              "after_apogee_long": flying & past_apogee & ~regular}  # fmt: skip
+    return {"flights": PHASE_FLIGHTS, "control_dt_s": settings.control_dt_s, "periods": float(np.median(flying.sum(1))),
+            **{name: {"periods": float(np.median(mask.sum(1))),
+                      "seconds": float(np.median(np.where(mask, length, 0.0).sum(1)))}
+               for name, mask in phases.items()}}  # fmt: skip
+
+
 @contextlib.contextmanager
 def float32_draws():
     """Make ``jax.random``'s normal, uniform and categorical draw in float32 (then cast to the
@@ -175,8 +208,8 @@ def _measure(spec: dict) -> dict:
     """One measurement in this process (``spec`` from ``_subprocess``), with this process's
     precision and peak resident memory [MB]."""
     campaign = load_campaign(spec["campaign"])
-    if spec["kind"] in TIMED_TOGETHER:
-        result = TIMED_TOGETHER[spec["kind"]](campaign, spec["repeats"])
+    if spec["kind"] in WHOLE_CAMPAIGN_KINDS:
+        result = WHOLE_CAMPAIGN_KINDS[spec["kind"]](campaign, spec["repeats"])
     else:
         campaign = with_overrides(campaign, n_realizations=spec["n"], aero_model=spec["model"])
         with float32_draws() if spec["float32_draws"] else contextlib.nullcontext():
@@ -187,8 +220,9 @@ def _measure(spec: dict) -> dict:
 
 # --- orchestration (in the calling process) ------------------------------------------------------
 
-TIMED_TOGETHER = {"ratios": ratios, "costs": costs}
-"""The measurements that time several flight functions together in one process, by kind."""
+WHOLE_CAMPAIGN_KINDS = {"ratios": ratios, "costs": costs, "periods": periods_by_phase}
+"""The measurements of the campaign file as it is (no N, model or chunk size of their own), by kind: the ratios and
+costs time several flight functions together; the periods by phase count."""
 
 
 class BenchError(RuntimeError):
@@ -232,7 +266,7 @@ def _subprocess(precision: str, cache: str | None = None, **spec) -> dict:
         done = subprocess.run(command, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
-        what = spec["kind"] if spec["kind"] in TIMED_TOGETHER else f"{spec['model']}, N = {spec['n']}"
+        what = spec["kind"] if spec["kind"] in WHOLE_CAMPAIGN_KINDS else f"{spec['model']}, N = {spec['n']}"
         raise BenchError(f"the measurement ({what}, {precision}) failed: {last}")
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -320,6 +354,9 @@ def run_benchmarks(
                 f"{c['impact_difference_m']['median']:.2f} m apart (median)")  # fmt: skip
     r = report["ratios"] = measure("ratios", path, precisions[0])
     log(f"batch ({precisions[0]}): {r['loop_over_batch']:.1f}x faster per flight than a loop")
+    r = report["periods_by_phase"] = measure("periods", path, precisions[0])
+    log(f"periods per flight ({precisions[0]}, median of {r['flights']}): {r['periods']:.0f}, "
+        f"{r['ascent']['periods']:.0f} up to apogee")  # fmt: skip
     c = report["costs"] = measure("costs", path, precisions[0])
     log(f"costs ({precisions[0]}, one core): interpolated {c['interpolated_over_simplified']:.2f}x the simplified, "
         f"closed loop {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s, sensors "
@@ -376,6 +413,12 @@ def format_report(report: dict) -> str:
         f"faster per flight than {r['loop_flights']} single flights in a loop ({1e3 * s['batch']:.2f} against "
         f"{1e3 * s['loop']:.1f} ms, simplified)"
     )
+    r = report["periods_by_phase"]
+    phase = lambda name, what: f"{r[name]['periods']:.0f} {what} ({r[name]['seconds']:.1f} s of flight)"  # noqa: E731
+    regular = f"of {r['control_dt_s']:g} s or less"
+    lines.append(f"  control periods per flight (median of {r['flights']}): {r['periods']:.0f}: "
+                 f"{phase('ascent', 'to apogee')}, {phase('after_apogee_regular', regular)} and "
+                 f"{phase('after_apogee_long', 'longer, in steady descent')} after it")  # fmt: skip
     c = report["costs"]
     s = c["s_per_flight"]
     lines.append(

@@ -14,7 +14,7 @@ import h5py
 import numpy as np
 import pytest
 
-from rocketmc.campaign import campaign_from_dict, load_campaign, read_campaign_tables, runner, with_overrides
+from rocketmc.campaign import campaign_from_dict, load_campaign, program, read_campaign_tables, runner, with_overrides
 from rocketmc.campaign.limits import fixed_reason
 from rocketmc.campaign.program import program_numbers, structure_fingerprint, with_numbers
 
@@ -90,6 +90,19 @@ def test_a_structure_change_is_another_program(monkeypatch):
         runner.compiled_chunk(c, 16)
     runner.compiled_chunk(changed[0], 16)
     assert lowered == [campaign, changed[0]]
+
+
+def test_another_code_is_another_cached_program(tmp_path, monkeypatch):
+    """A program exported by other code (an edited editable install) is not read back: the cache file's name hashes
+    rocketmc's source (``source_digest``) too."""
+    monkeypatch.setattr(program, "CACHE_DIR", str(tmp_path))
+    double = lambda x: 2.0 * x  # noqa: E731
+    program.cached_program("probe", "key", double, np.ones(3))
+    program.cached_program("probe", "key", double, np.ones(3))  # read back
+    assert len(list((tmp_path / "programs").iterdir())) == 1
+    monkeypatch.setattr(program, "source_digest", lambda: "edited")
+    program.cached_program("probe", "key", double, np.ones(3))
+    assert len(list((tmp_path / "programs").iterdir())) == 2
 
 
 def test_small_runs_share_batches():

@@ -47,6 +47,8 @@ def flights():
     for case in ("off", "1s", "3p5s"):
         campaign = headwind(f"lynx_ballistic_ctrl_{case}")
         settings = sim_settings(campaign)
+        if case == "off":  # the controller's periods (no event periods), so the idle controller's flight is its twin
+            settings = dataclasses.replace(settings, event_periods=False)
         fly_once = jax.jit(lambda p: (lambda s, tr: (tr, flight_summary(p, s)[0]))(*fly(p, settings, N_PERIODS)))
         out[case] = (nominal_params(campaign), *fly_once(nominal_params(campaign)))
     return out

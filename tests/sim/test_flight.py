@@ -25,7 +25,7 @@ from rocketmc.env import G0, isa
 from rocketmc.math import Vec3
 from rocketmc.math.table import Table
 from rocketmc.sim.events import rail_start_n, rail_travel_m
-from rocketmc.sim.flight import fly, initial_state, simulate_one
+from rocketmc.sim.flight import EVENT_OVERSHOOT, fly, initial_state, simulate_one
 from rocketmc.sim.loads import derivatives, mass_properties
 from rocketmc.sim.outputs import METRICS, flight_summary, metric
 from rocketmc.sim.params import SimSettings
@@ -249,10 +249,12 @@ def test_vacuum_rail_exit_matches_the_rail_ode(vacuum_flight, settings):
         y, t0 = sol.y[:, -1], t1
     else:
         pytest.fail("the reference never left the rail")
-    # The simulator finds the exit by linear interpolation inside a 20 ms period while the rocket
-    # accelerates at a ≈ 66 m/s²: ≤ a h²/(8 v) ≈ 1.7e-4 s, i.e. ≤ a·that ≈ 0.011 m/s; RK4 also
-    # integrates the thrust curve's kinks inside steps with an O(h²·Δslope) error. Measured:
-    # 2.0e-4 s and 6.3e-3 m/s. Tolerances: 5e-4 s and 0.02 m/s (0.1 %).
+    # The simulator finds the exit by linear interpolation inside a period while the rocket accelerates at
+    # a ≈ 66 m/s²: ≤ a h²/(8 v) ≈ 1.7e-4 s at h = 20 ms, i.e. ≤ a·that ≈ 0.011 m/s; its periods end at the thrust
+    # curve's points and just past the exit (``event_period``), but the first one holds liftoff (the rocket rests
+    # until the thrust exceeds its weight along the rail: a kink ~3 ms after ignition). Measured: 2.6e-4 s and
+    # 7.3e-4 m/s (2.0e-4 s and 6.3e-3 m/s with the kinks inside 20 ms steps). Tolerances: 5e-4 s and 0.02 m/s
+    # (0.1 %).
     assert s["rail_exit_time_s"] == pytest.approx(t_exit, abs=5e-4)
     assert s["rail_exit_speed_mps"] == pytest.approx(v_exit, abs=0.02)
     assert float(motor.ignition_time_s) < s["rail_exit_time_s"] < s["burnout_time_s"]
@@ -409,17 +411,41 @@ def test_attitude_stays_unit_and_state_finite(windy_flight):
 
 
 def test_tick_counts_control_periods(windy_flight, settings):
-    """The tick is +1 per period, also in steady descent (longer periods) and after landing; until the
-    first longer period the clock is tick·control_dt_s."""
+    """The tick is +1 per period, also in steady descent (longer periods), in the periods that end at an event
+    (shorter: ``event_period``) and after landing; until the first longer period every period is ``control_dt_s``
+    but those, and the clock is their float sum."""
     _, traj, _, _ = windy_flight
     assert traj.tick.dtype == np.int32
     np.testing.assert_array_equal(traj.tick, np.arange(1, N_PERIODS + 1))
     periods = np.diff(traj.t, prepend=0.0)
     first_long = int(np.argmax(periods > settings.control_dt_s * (1 + 1e-9)))
     assert first_long > 100  # after the climb, under canopy
-    # the clock is a float sum of the periods: rounding of ~1e-16 relative per period
-    np.testing.assert_allclose(traj.t[:first_long], traj.tick[:first_long] * settings.control_dt_s, rtol=1e-12)
+    regular = np.isclose(periods[:first_long], settings.control_dt_s, rtol=1e-9, atol=0)
+    assert 5 < np.count_nonzero(~regular) < 30  # the rail exit, two wind-layer boundaries up, thrust-curve points
+    assert np.all(periods[:first_long][~regular] < settings.control_dt_s)
     assert traj.t[-1] > N_PERIODS * settings.control_dt_s  # the descent periods are longer
+
+
+def test_periods_end_at_the_events(windy_flight, settings):
+    """Without a controller and sensors, a period ends at each thrust-curve point (exactly), and just past the
+    rail exit and each wind-layer boundary crossing (predicted at the period start's velocity, overshot by
+    ``EVENT_OVERSHOOT`` of the period)."""
+    p, traj, s, _ = windy_flight
+    t = np.concatenate([[0.0], traj.t])
+    dt = settings.control_dt_s
+    points = float(p.rocket.motor.ignition_time_s) + np.asarray(p.rocket.motor.time_s)
+    np.testing.assert_allclose(t[np.abs(t[:, None] - points).argmin(axis=0)], points, rtol=0, atol=1e-12)
+    # the rail exit: accelerating at ~66 m/s² from ~20 m/s, the exit comes ~a·τ²/(2v) ≈ 0.7 ms before the end of a
+    # 20 ms period predicted at the start's speed
+    j = bracket(t, s["rail_exit_time_s"])
+    assert 0.0 < t[j + 1] - s["rail_exit_time_s"] <= EVENT_OVERSHOOT * dt + 1e-3
+    altitude = np.concatenate([[0.0], -traj.body.r_n.z])
+    apogee = int(np.argmax(altitude))
+    for boundary in np.asarray(p.environment.wind.bottom_m)[1:]:
+        j = int(np.argmax(altitude[:apogee] > boundary)) - 1  # the period in which the climb crosses it
+        crossing = t[j] + (t[j + 1] - t[j]) * (boundary - altitude[j]) / (altitude[j + 1] - altitude[j])
+        # climbing at ~100-200 m/s against ~30 m/s² of deceleration: the overshoot plus a few 1e-5 s
+        assert 0.0 < t[j + 1] - crossing <= EVENT_OVERSHOOT * dt + 1e-4
 
 
 def test_every_output_has_a_metric(windy_flight):

@@ -42,7 +42,8 @@ def energy_balance(record: FlightRecord) -> EnergyBalance:
     to the last before apogee: constant mass, no thrust, no canopy, so d(½mV² + m·g0·h)/dt = F_aero·v exactly)
     against the aerodynamic work, each period integrated by the trapezoid rule from its two ends with its own gust.
     Periods that cross a height where the mean wind jumps are left out: the power jumps inside them, where neither
-    RK4 nor the trapezoid is accurate (seen: 11 J of the 12 J difference over the lynx_nominal coast).
+    RK4 nor the trapezoid is accurate (seen: 11 J of the 12 J difference over the lynx_nominal coast); so are their
+    slopes from the curvature (a period that ends just past a jump, ``sim.flight.event_period``, has a steep one).
 
     tolerance: the trapezoid's error, h³/12·|P''| per period, with P'' from the differences of neighbouring
     periods' secant slopes, doubled (that estimate is itself an estimate); RK4's own error, O(h⁵) per step, and
@@ -53,14 +54,14 @@ def energy_balance(record: FlightRecord) -> EnergyBalance:
     h = np.diff(t[first : last + 1])
     start = s["aero_power"].to_numpy()[first:last]
     end = record.aero_power_end_w[first:last]
-    slope = (end - start) / h
-    curvature = np.gradient(slope, np.cumsum(h) - 0.5 * h)
     altitude = s["altitude"].to_numpy()[first : last + 1]
     low, high = np.minimum(altitude[:-1], altitude[1:]), np.maximum(altitude[:-1], altitude[1:])
     smooth = ~np.any((low[:, None] <= record.wind_jumps_m) & (record.wind_jumps_m <= high[:, None]), axis=1)
+    slope = (end - start) / h  # the curvature from the smooth periods' slopes: a jump's would poison its neighbours'
+    curvature = np.gradient(slope[smooth], (np.cumsum(h) - 0.5 * h)[smooth])
     energy = np.diff(s["mechanical_energy"].to_numpy()[first : last + 1])
     work = 0.5 * h * (start + end)
-    tolerance = 2.0 * float(np.sum((h**3 / 12.0 * np.abs(curvature))[smooth]))
+    tolerance = 2.0 * float(np.sum(h[smooth] ** 3 / 12.0 * np.abs(curvature)))
     return EnergyBalance(float(t[first]), float(t[last]), int(smooth.sum()), int((~smooth).sum()),
                          float(energy[smooth].sum()), float(work[smooth].sum()), tolerance)  # fmt: skip
 

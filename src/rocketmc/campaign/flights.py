@@ -9,8 +9,9 @@ the end of the first block of ``block_steps`` periods at which the flight is don
 
 Sample k is the state at the start of period k (the first at t = 0 at rest on the rail), with ``sim.loads.loads``
 there: the gust and canard deflections of the period starting at that instant, i.e. its first RK4 stage. The
-periods are the flight's own (``control_dt_s``, longer in steady descent under canopy). Positions along the rocket
-(CG, centre of pressure) are distances from the nose tip [m], angles in degrees, everything else SI.
+periods are the flight's own (``control_dt_s``, longer in steady descent under canopy, shorter at events without a
+controller: ``sim.flight.event_period``). Positions along the rocket (CG, centre of pressure) are distances from the
+nose tip [m], angles in degrees, everything else SI.
 
 Every recorded flight is compiled once per campaign structure and kind (``compiled_flight``), kept per process.
 """

@@ -17,6 +17,8 @@ same text: a number read as a constant instead of an argument would show there.
 from __future__ import annotations
 
 import dataclasses
+import functools
+import hashlib
 import json
 import os
 import pickle
@@ -123,17 +125,29 @@ def _as_data(leaves: list) -> list:
     return [jax.random.key_data(x) if _is_key(x) else x for x in leaves]
 
 
+@functools.cache
+def source_digest() -> str:
+    """SHA-256 of rocketmc's Python files (~0.01 s, once per process): a program exported by other code (an editable
+    install edited, a version that kept its number) is not read back as this code's."""
+    package = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for path in sorted(package.rglob("*.py")):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()
+
+
 def cached_program(name: str, key: str, function: Callable, *example_args, in_specs=None, out_spec=None) -> Program:
     """``function`` (jitted; pytrees in and out) through ``jax.export`` at the shapes of ``example_args``: read from the
     cache folder (``runtime.CACHE_DIR``: programs/NAME-HASH.jaxexport, the hash of ``key``, naming all the program
-    depends on besides its arguments, and of the arguments' tree and shapes) where a process saved it, else traced
-    now and saved there (written whole, then renamed: processes sharing the folder never read half a file). The
-    ``Program`` is jitted from the export either way, hence the same bits. ``in_specs``: a PartitionSpec per argument
+    depends on besides its arguments, of the arguments' tree and shapes and of rocketmc's code, ``source_digest``)
+    where a process saved it, else traced now and saved there (written whole, then renamed: processes sharing the
+    folder never read half a file). The ``Program`` is jitted from the export either way, hence the same bits. ``in_specs``: a PartitionSpec per argument
     and ``out_spec`` one for every output, over a mesh of the local devices (None: one device)."""
     leaves, in_tree = jax.tree_util.tree_flatten(example_args)
     in_keys = [_is_key(x) for x in leaves]
     shapes = [f"{x.dtype}{np.shape(x)}" if hasattr(x, "dtype") else type(x).__name__ for x in leaves]
-    digest = fingerprint({"key": key, "tree": str(in_tree), "leaves": shapes, "devices": jax.local_device_count()})
+    digest = fingerprint({"key": key, "tree": str(in_tree), "leaves": shapes, "devices": jax.local_device_count(),
+                          "source": source_digest()})  # fmt: skip
     path = None if CACHE_DIR is None else Path(CACHE_DIR) / "programs" / f"{name}-{digest}.jaxexport"
     loaded = _load(path)
     if loaded is None:

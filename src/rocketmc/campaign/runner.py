@@ -38,7 +38,7 @@ def sim_settings(campaign: Campaign) -> SimSettings:
     s = campaign.config.simulation
     return SimSettings(
         control_dt_s=s.control_dt_s, substeps=s.substeps, descent_dt_s=max(s.descent_dt_s, s.control_dt_s),
-        descent_h_omega=s.descent_h_omega, max_time_s=s.max_time_s,
+        descent_h_omega=s.descent_h_omega, event_periods=s.event_periods, max_time_s=s.max_time_s,
     )
 
 

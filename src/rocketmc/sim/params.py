@@ -104,6 +104,8 @@ class SimSettings:
     descent_dt_s: the longer period used under a fully open canopy, once opening transients have
     settled (``settle_s`` after full opening); the GNC is idle then [s]; ``descent_h_omega``: the
     largest RK4 step h times the body's pendulum rate ω under its canopies there;
+    event_periods: without a controller and sensors, end a period at the rail exit, a wind-layer boundary and a
+    thrust-curve point (``sim.flight.event_period``); False: the GNC grid's periods, as with a controller;
     max_time_s: a flight not on the ground by then gets the status MAX_TIME;
     block_steps: control periods per chunk of work between checks that the whole batch has landed.
     """
@@ -113,5 +115,6 @@ class SimSettings:
     descent_dt_s: float = 0.25
     descent_h_omega: float = 1.0
     settle_s: float = 1.0
+    event_periods: bool = True
     max_time_s: float = 300.0
     block_steps: int = 100

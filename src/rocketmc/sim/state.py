@@ -82,8 +82,9 @@ class FlightState:
     without a controller) and the avionics' (None without sensors).
 
     tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A long period of
-    steady descent (``steady_descent``: up to ``settings.descent_dt_s``, the GNC idle) counts one too, so
-    ``t = tick·control_dt_s`` (up to the rounding of the summed periods) only until the first of them."""
+    steady descent (``steady_descent``: up to ``settings.descent_dt_s``, the GNC idle) counts one too, as does,
+    without a controller and sensors, a period ending at an event (``sim.flight.event_period``), so with them
+    ``t = tick·control_dt_s`` (up to the rounding of the summed periods) only until the first long period."""
 
     t: jnp.ndarray
     tick: jnp.ndarray
