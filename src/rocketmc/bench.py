@@ -414,11 +414,11 @@ def format_report(report: dict) -> str:
         f"{1e3 * s['loop']:.1f} ms, simplified)"
     )
     r = report["periods_by_phase"]
-    phase = lambda name, what: f"{r[name]['periods']:.0f} {what} ({r[name]['seconds']:.1f} s of flight)"  # noqa: E731
-    regular = f"of {r['control_dt_s']:g} s or less"
-    lines.append(f"  control periods per flight (median of {r['flights']}): {r['periods']:.0f}: "
-                 f"{phase('ascent', 'to apogee')}, {phase('after_apogee_regular', regular)} and "
-                 f"{phase('after_apogee_long', 'longer, in steady descent')} after it")  # fmt: skip
+    ascent, regular, long = (r[name] for name in ("ascent", "after_apogee_regular", "after_apogee_long"))
+    lines.append(f"  control periods per flight (median of {r['flights']}): {r['periods']:.0f}; to apogee "
+                 f"{ascent['periods']:.0f} ({ascent['seconds']:.1f} s of flight); after it {regular['periods']:.0f} of "
+                 f"{r['control_dt_s']:g} s or less ({regular['seconds']:.1f} s) and {long['periods']:.0f} longer ones "
+                 f"in steady descent ({long['seconds']:.1f} s)")  # fmt: skip
     c = report["costs"]
     s = c["s_per_flight"]
     lines.append(
