@@ -141,8 +141,9 @@ def cached_program(name: str, key: str, function: Callable, *example_args, in_sp
     cache folder (``runtime.CACHE_DIR``: programs/NAME-HASH.jaxexport, the hash of ``key``, naming all the program
     depends on besides its arguments, of the arguments' tree and shapes and of rocketmc's code, ``source_digest``)
     where a process saved it, else traced now and saved there (written whole, then renamed: processes sharing the
-    folder never read half a file). The ``Program`` is jitted from the export either way, hence the same bits. ``in_specs``: a PartitionSpec per argument
-    and ``out_spec`` one for every output, over a mesh of the local devices (None: one device)."""
+    folder never read half a file). The ``Program`` is jitted from the export either way, hence the same bits.
+    ``in_specs``: a PartitionSpec per argument and ``out_spec`` one for every output, over a mesh of the local devices
+    (None: one device)."""
     leaves, in_tree = jax.tree_util.tree_flatten(example_args)
     in_keys = [_is_key(x) for x in leaves]
     shapes = [f"{x.dtype}{np.shape(x)}" if hasattr(x, "dtype") else type(x).__name__ for x in leaves]

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from ..errors import RocketmcError
@@ -42,7 +42,7 @@ def _silent(line: str, transient: bool = False) -> None:
 
 
 def _warn(line: str) -> None:
-    warnings.warn(" ".join(line.split()), RunWarning, stacklevel=5)  # the caller of run_campaign
+    warnings.warn(" ".join(line.split()), RunWarning, stacklevel=4)  # the caller of run_campaign
 
 
 def kept_trajectories(campaign: Campaign, realizations: Sequence[int]) -> list[int]:
@@ -93,17 +93,11 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
 
 def _fly(campaign: Campaign, writer: ResultWriter, executor: Callable, until_converged_pct: float | None,
          kept: list[int], interval_s: float, progress: Callable[..., None], warn: Callable[[str], None]) -> Path:  # fmt: skip
-    """``run_campaign``'s loop once its writer holds the partial folder."""
-    with ThreadPoolExecutor(1) as pool:  # the pre-flight checks beside the compilation, which leaves a core idle
-        checks = pool.submit(preflight_warnings, campaign)
-        return _fly_checked(campaign, writer, executor, until_converged_pct, kept, interval_s, progress, warn, checks)
-
-
-def _fly_checked(campaign: Campaign, writer: ResultWriter, executor: Callable, until_converged_pct: float | None,
-                 kept: list[int], interval_s: float, progress: Callable[..., None], warn: Callable[[str], None],
-                 checks: Future) -> Path:  # fmt: skip
-    """``_fly`` with the pre-flight warnings ``checks`` will give: warned once the chunks have compiled (or when
-    there is nothing to fly), before the first flight."""
+    """``run_campaign``'s loop once its writer holds the partial folder. The pre-flight checks run on a thread beside
+    the compilation (which leaves a core idle); their warnings come once it is done, before the first flight."""
+    pool = ThreadPoolExecutor(1)
+    checks = pool.submit(preflight_warnings, campaign)
+    pool.shutdown(wait=False)  # the thread ends with the checks
     cfg = campaign.config
     chunk_size, n_chunks = writer.chunk_size, writer.n_chunks
     done = set(writer.completed_chunks())

@@ -607,9 +607,11 @@ class SimulationConfig(_Strict):
     descent_h_omega: float = Field(
         1.0, gt=0, le=2.0, description="largest RK4 step times the body's pendulum rate under canopy (RK4 is stable to 2.8)"
     )
-    event_periods: bool = Field(True, description="without [gnc] and [avionics], end a period at the rail exit, a wind-layer "
-                                "boundary and a thrust-curve point (docs/validation.md, 'Step size'); false: every period "
-                                "control_dt_s until steady descent, as with a controller (pairs flights with a controller's)")
+    event_periods: bool = Field(
+        True, description="without [gnc] and [avionics], end a period at the rail exit, a wind-layer boundary and a "
+                          "thrust-curve point (docs/validation.md, 'Step size'); false: every period control_dt_s until "
+                          "steady descent, as with a controller (pairs flights with a controller's)"
+    )  # fmt: skip
     max_time_s: float = Field(300.0, gt=0, le=MAX_FLIGHT_TIME_S, description="a flight still up by then stops")
     chunk_size: int = Field(1000, ge=1, le=MAX_REALIZATIONS, description="realizations per compiled batch")
 

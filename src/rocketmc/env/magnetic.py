@@ -115,9 +115,9 @@ def site_field_gradient(latitude_deg, longitude_deg, altitude_m, decimal_year: f
 
 
 IGRF14_TABLE = os.path.join(importlib.util.find_spec("ppigrf").submodule_search_locations[0], "IGRF14.shc")
-"""ppigrf's IGRF-14 coefficient table (.shc; its ``shc_fn_igrf14``, found without importing ppigrf, which imports pandas:
-~0.2 s before a run's first flight, needed only with a magnetometer): main-field models every 5 years 1900.0–2025.0 and 2030.0, the 2025.0
-model moved by the predictive secular variation (data/igrf/SOURCE.md)."""
+"""ppigrf's IGRF-14 coefficient table (.shc; its ``shc_fn_igrf14``, found without importing ppigrf, which imports
+pandas: ~0.2 s before a run's first flight, needed only with a magnetometer): main-field models every 5 years
+1900.0–2025.0 and 2030.0, the 2025.0 model moved by the predictive secular variation (data/igrf/SOURCE.md)."""
 IGRF14_VALIDITY = (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1))
 """``igrf_validity`` of ``IGRF14_TABLE``, known without reading it (tests/env/test_magnetic.py reads it): the campaign's
 date check needs no ppigrf."""

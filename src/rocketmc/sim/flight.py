@@ -102,17 +102,18 @@ def event_period(p: FlightParams, start_n: Vec3, state: FlightState, period):
     2.0 m; with 40 ms periods, the thrust curve's points took the apogee's median error from 0.24 % to 0.004 %:
     docs/validation.md, "Step size")."""
     rail = p.launch.rail_direction_n
-    along = state.body.v_n.dot(rail)
-    to_exit = (rail_travel_m(p) - (state.body.r_n - start_n).dot(rail)) / jnp.where(along > 0.0, along, 1.0)
-    to_switch = jnp.where(jnp.isinf(state.events.rail_exit_time) & (along > 0.0), to_exit, jnp.inf)
-    climb, altitude = -state.body.v_n.z, -state.body.r_n.z
+    travel = rail_travel_m(p) - (state.body.r_n - start_n).dot(rail)
+    to_switch = jnp.where(jnp.isinf(state.events.rail_exit_time), _time_to(travel, state.body.v_n.dot(rail)), jnp.inf)
     for boundary in p.environment.wind.jump_altitudes_m():
-        gap = boundary - altitude
-        to_switch = jnp.minimum(to_switch, jnp.where(gap * climb > 0.0, gap / jnp.where(climb != 0.0, climb, 1.0),
-                                                     jnp.inf))  # fmt: skip
+        to_switch = jnp.minimum(to_switch, _time_to(boundary + state.body.r_n.z, -state.body.v_n.z))
     to_kink = p.rocket.motor.ignition_time_s + p.rocket.motor.time_s - state.t
     to_kink = jnp.min(jnp.where(to_kink > CLOCK_RESOLUTION_S, to_kink, jnp.inf))
     return jnp.minimum(jnp.minimum(to_switch + EVENT_OVERSHOOT * period, to_kink), period)
+
+
+def _time_to(gap, speed):
+    """Time [s] to close ``gap`` [m] at ``speed`` [m/s] along it; inf when moving away or still."""
+    return jnp.where(gap * speed > 0.0, gap / jnp.where(speed != 0.0, speed, 1.0), jnp.inf)
 
 
 def period_gust(p: FlightParams, state: FlightState):
