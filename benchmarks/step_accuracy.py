@@ -1,19 +1,21 @@
 """Accuracy of the campaign's steps: the same realizations flown with its steps and with a reference whose RK4 step
 is ``--factor`` times finer (control-period substeps).
 
-The reference ``periods`` (default) also flies every period at ``control_dt_s``, no long descent periods: a tenth of
-the campaign's step everywhere. Its turbulence then draws one noise row per 20 ms period under canopy where the
-campaign draws one per long period, so with turbulence the two fly different gusts under canopy (the same statistics,
-another realization): ``--calm`` sets every realization's turbulence severity to none, so the differences are the
-integration's; the reference ``substeps`` keeps the campaign's periods and refines only the RK4 step (the same gusts).
+The reference ``periods`` (default) also flies every period at ``control_dt_s`` (20 ms), no longer open-loop
+(``open_loop_dt_s``) or descent periods: a tenth of the 20 ms step everywhere. Its turbulence then draws one noise row
+per 20 ms period where the campaign draws one per longer period, so with turbulence the two fly different gusts (the
+same statistics, another realization): ``--calm`` sets every realization's turbulence severity to none, so the
+differences are the integration's; the reference ``substeps`` keeps the campaign's periods and refines only the RK4
+step (the same gusts). ``--set`` changes the measured flights' campaign values, not the reference's.
 
     python benchmarks/step_accuracy.py [--campaign campaigns/lynx_nominal.toml] [--n 200] [--factor 10]
-                                       [--reference periods|substeps] [--calm]
+                                       [--reference periods|substeps] [--calm] [--set KEY=VALUE ...]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 
 import numpy as np
 
@@ -25,6 +27,12 @@ def outputs(campaign) -> dict:
     return {k: np.concatenate([c.outputs[k] for c in chunks]) for k in chunks[0].outputs}
 
 
+def _steps(campaign) -> str:
+    sim = campaign.config.simulation
+    return (f"periods {sim.control_dt_s:g} s, open loop {sim.open_loop_dt_s or sim.control_dt_s:g} s, descent up to {sim.descent_dt_s:g} s, "
+            f"{sim.substeps} RK4 steps each{', point-mass descent' if sim.point_mass_descent else ''}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--campaign", default="campaigns/lynx_nominal.toml")
@@ -32,6 +40,8 @@ def main() -> None:
     parser.add_argument("--factor", type=int, default=10, help="RK4 substeps of the reference per campaign substep")
     parser.add_argument("--reference", choices=("periods", "substeps"), default="periods")
     parser.add_argument("--calm", action="store_true", help="no turbulence in any realization")
+    parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
+                        help="campaign values of the flights measured (not the reference's), e.g. simulation.descent_h_rate=2")
     args = parser.parse_args()
     campaign = load_campaign(args.campaign)
     calm = {}
@@ -41,15 +51,17 @@ def main() -> None:
     sim = campaign.config.simulation
     finer = {"simulation.substeps": args.factor * sim.substeps}
     if args.reference == "periods":
-        finer["simulation.descent_dt_s"] = sim.control_dt_s
+        finer["simulation.descent_dt_s"] = finer["simulation.open_loop_dt_s"] = sim.control_dt_s
+        finer["simulation.point_mass_descent"] = False
     fine = with_overrides(campaign, values=finer)
-    fine_sim = fine.config.simulation
+    measured = {key: json.loads(value) for key, value in (item.split("=", 1) for item in args.set)}
+    campaign = with_overrides(campaign, values=measured)
     a, b = outputs(campaign), outputs(fine)
-    print(f"{campaign.config.name}, N={args.n}{', calm' if args.calm else ''}: campaign steps (substeps "
-          f"{sim.substeps}, descent {sim.descent_dt_s} s) vs reference (substeps {fine_sim.substeps}, descent "
-          f"{fine_sim.descent_dt_s} s)")  # fmt: skip
+    print(f"{campaign.config.name}, N={args.n}{', calm' if args.calm else ''}: campaign ({_steps(campaign)}) vs "
+          f"reference ({_steps(fine)})")
     miss = np.hypot(a["impact_north_m"] - b["impact_north_m"], a["impact_east_m"] - b["impact_east_m"])
-    print(f"  impact point difference: median {np.nanmedian(miss):.3f} m, max {np.nanmax(miss):.3f} m")
+    print(f"  impact point difference: median {np.nanmedian(miss):.3f} m, max {np.nanmax(miss):.3f} m (realization "
+          f"{np.nanargmax(miss)})")
     apogee = np.abs(a["apogee_agl_m"] / b["apogee_agl_m"] - 1.0)
     print(f"  apogee relative difference: median {np.nanmedian(apogee):.2e}, max {np.nanmax(apogee):.2e}")
     for name in ("apogee_time_s", "impact_time_s", "impact_speed_mps", "rail_exit_speed_mps"):

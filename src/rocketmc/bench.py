@@ -41,7 +41,7 @@ from .runtime import PRECISION
 from .ellipse import confidence_ellipse
 from .campaign import load_campaign, run_chunks, with_overrides
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, realization_params, sim_settings
-from .sim.flight import fly
+from .sim.flight import fly, regular_period_s
 from .sim.state import Status, done
 
 DEFAULT_CAMPAIGN = Path(str(resources.files("rocketmc") / "data" / "campaigns" / "lynx_nominal.toml"))
@@ -141,11 +141,13 @@ PHASE_FLIGHTS = 32
 
 def periods_by_phase(campaign, repeats: int | None = None) -> dict:
     """Control periods per flight, median over ``PHASE_FLIGHTS`` realizations (``repeats`` unused: nothing is timed):
-    in all, in the ascent (to apogee), after apogee at ``control_dt_s`` (the canopies' openings and settling, wind-layer
-    boundaries) and in the longer steady-descent periods, each with its median seconds of flight."""
+    in all, in the ascent (to apogee), after apogee in regular periods (``sim.flight.regular_period_s``: the canopies'
+    openings and settling, wind-layer boundaries) and in the longer steady-descent periods, each with its median
+    seconds of flight."""
     settings = sim_settings(campaign)
     master = jax.random.key(campaign.config.seed)
-    n_periods = math.ceil(settings.max_time_s / settings.control_dt_s)
+    regular_s = regular_period_s(realization_params(campaign, master, jnp.uint32(0))[0], settings)
+    n_periods = math.ceil(settings.max_time_s / regular_s)
 
     def periods(index):
         p, _ = realization_params(campaign, master, index)
@@ -156,10 +158,10 @@ def periods_by_phase(campaign, repeats: int | None = None) -> dict:
     t, past_apogee, landed = map(np.asarray, jax.jit(jax.vmap(periods))(indices))
     length = np.diff(t, axis=1, prepend=0.0)
     flying = ~np.concatenate([np.zeros((PHASE_FLIGHTS, 1), bool), landed[:, :-1]], axis=1)  # the landing one counts
-    regular = length <= settings.control_dt_s * (1 + 1e-9)  # the sum of periods rounds: not a long one
+    regular = length <= regular_s * (1 + 1e-9)  # the sum of periods rounds: not a long one
     phases = {"ascent": flying & ~past_apogee, "after_apogee_regular": flying & past_apogee & regular,
               "after_apogee_long": flying & past_apogee & ~regular}  # fmt: skip
-    return {"flights": PHASE_FLIGHTS, "control_dt_s": settings.control_dt_s, "periods": float(np.median(flying.sum(1))),
+    return {"flights": PHASE_FLIGHTS, "regular_period_s": regular_s, "periods": float(np.median(flying.sum(1))),
             **{name: {"periods": float(np.median(mask.sum(1))),
                       "seconds": float(np.median(np.where(mask, length, 0.0).sum(1)))}
                for name, mask in phases.items()}}  # fmt: skip
@@ -417,7 +419,7 @@ def format_report(report: dict) -> str:
     ascent, regular, long = (r[name] for name in ("ascent", "after_apogee_regular", "after_apogee_long"))
     lines.append(f"  control periods per flight (median of {r['flights']}): {r['periods']:.0f}; to apogee "
                  f"{ascent['periods']:.0f} ({ascent['seconds']:.1f} s of flight); after it {regular['periods']:.0f} of "
-                 f"{r['control_dt_s']:g} s or less ({regular['seconds']:.1f} s) and {long['periods']:.0f} longer ones "
+                 f"{r['regular_period_s']:g} s or less ({regular['seconds']:.1f} s) and {long['periods']:.0f} longer ones "
                  f"in steady descent ({long['seconds']:.1f} s)")  # fmt: skip
     c = report["costs"]
     s = c["s_per_flight"]

@@ -58,7 +58,7 @@ def flight():
     campaign = campaign_from_dict(data)
     config = campaign.config
     dt = config.simulation.control_dt_s
-    settings = dataclasses.replace(sim_settings(campaign), descent_dt_s=dt)
+    settings = dataclasses.replace(sim_settings(campaign), descent_dt_s=dt, point_mass_descent=False)
     params, _ = realization_params(campaign, jax.random.key(config.seed), np.uint32(0))
     n = math.ceil(FLIGHT_S / dt)
     record = lambda s: (s.avionics.bus, s.body)  # noqa: E731

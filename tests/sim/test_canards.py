@@ -68,7 +68,10 @@ def host(tree):
 
 @pytest.fixture(scope="module")
 def settings(lynx_campaign):
-    return sim_settings(lynx_campaign)
+    """The campaign's, at the GNC's 20 ms periods (the canards are a controller's actuators; lynx_nominal's own
+    open-loop periods are 40 ms)."""
+    settings = sim_settings(lynx_campaign)
+    return dataclasses.replace(settings, open_loop_dt_s=settings.control_dt_s)
 
 
 @pytest.fixture(scope="module")

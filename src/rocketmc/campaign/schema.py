@@ -607,10 +607,24 @@ class SimulationConfig(_Strict):
     descent_h_omega: float = Field(
         1.0, gt=0, le=2.0, description="largest RK4 step times the body's pendulum rate under canopy (RK4 is stable to 2.8)"
     )
+    point_mass_descent: bool = Field(
+        True, description="in steady descent, once the body's swing has died out (swing_settle_s), fly it as a point "
+                          "mass in periods of up to 5 s (docs/validation.md, 'Step size')"
+    )  # fmt: skip
+    swing_settle_s: float = Field(
+        5.0, ge=0, le=60.0, description="seconds flown with 6 degrees of freedom after a canopy has settled or a "
+                                        "wind-layer boundary was crossed, before a point mass"
+    )  # fmt: skip
     event_periods: bool = Field(
-        True, description="without [gnc] and [avionics], end a period at the rail exit, a wind-layer boundary and a "
-                          "thrust-curve point (docs/validation.md, 'Step size'); false: every period control_dt_s until "
-                          "steady descent, as with a controller (pairs flights with a controller's)"
+        True, description="without [gnc] and [avionics], fly periods of open_loop_dt_s that end at the rail exit, a "
+                          "wind-layer boundary and a thrust-curve point (docs/validation.md, 'Step size'); false: every "
+                          "period control_dt_s until steady descent, as with a controller (pairs flights with a "
+                          "controller's)"
+    )  # fmt: skip
+    open_loop_dt_s: float | None = Field(
+        None, ge=MIN_CONTROL_DT_S, le=0.1, description="period without [gnc] and [avionics] when event_periods is true "
+                                                       "(default control_dt_s; measure a longer one with "
+                                                       "benchmarks/step_accuracy.py: docs/validation.md, 'Step size')"
     )  # fmt: skip
     max_time_s: float = Field(300.0, gt=0, le=MAX_FLIGHT_TIME_S, description="a flight still up by then stops")
     chunk_size: int = Field(1000, ge=1, le=MAX_REALIZATIONS, description="realizations per compiled batch")

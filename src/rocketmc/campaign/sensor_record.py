@@ -45,7 +45,7 @@ def sensor_record(campaign: Campaign, realization: int = 0, static_s: float | No
     what = "its flight" if static_s is None else f"{static_s:g} s at rest on the pad"
     log(f"{config.name}: realization {realization}, {what} (compiling, then flying)")
     dt = config.simulation.control_dt_s
-    settings = dataclasses.replace(sim_settings(campaign), descent_dt_s=dt)
+    settings = dataclasses.replace(sim_settings(campaign), descent_dt_s=dt, point_mass_descent=False)
     params, _ = realization_params(campaign, jax.random.key(config.seed), np.uint32(realization))
     if static_s is not None:
         motor = dataclasses.replace(params.rocket.motor, ignition_time_s=jnp.asarray(jnp.inf))

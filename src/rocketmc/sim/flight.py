@@ -29,7 +29,7 @@ from .faults import faulty_servos, faulty_sensors
 from .loads import derivatives, mass_properties
 from .outputs import flight_summary
 from .params import FlightParams, SimSettings
-from .state import Events, FlightState, done
+from .state import Canopy, Events, FlightState, done
 
 
 def initial_state(p: FlightParams) -> FlightState:
@@ -46,37 +46,110 @@ def initial_state(p: FlightParams) -> FlightState:
     filters = None if turbulence is None else initial_turbulence(turbulence)
     gnc = None if p.gnc is None else initial_gnc(p.gnc, zero)
     avionics = None if p.avionics is None else initial_avionics(p.avionics, zero)
-    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, zero, filters, gnc, avionics)
-
+    return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, Canopy(zero, zero), filters, gnc,
+                       avionics)  # fmt: skip
 
 
 def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
-    """True under a fully open canopy once every triggered opening has settled, unless a wind-layer
-    boundary is within one descent step (its wind jump is a transient too)."""
+    """Whether the period starting at ``state`` is one of steady descent and whether the body flies it as a point
+    mass (bools). Steady: under a fully open canopy once every triggered opening has settled (``settings.settle_s``
+    after full opening), unless a wind-layer boundary is within ``_reach_m`` (its wind jump is a transient too). A
+    point mass (with ``settings.point_mass_descent``): steady, ``settings.swing_settle_s`` after the last opening
+    settled and after the last wind-layer boundary crossed, when the body's swing under its canopies has died out,
+    and not within ``_reach_m`` of a trigger altitude still to come (False without it)."""
     t, events = state.t, state.events
-    any_open, transient = False, False
+    any_open = transient = swinging = jnp.zeros_like(t, dtype=bool)
     for chute, trigger_time in zip(p.rocket.parachutes, events.chute_trigger_times):
         settled = trigger_time + chute.delay_s + chute.opening_time_s + settings.settle_s
         any_open = any_open | (t >= settled)
         transient = transient | (jnp.isfinite(trigger_time) & (t < settled))
-    altitude = -state.body.r_n.z
-    reach = jnp.abs(state.body.v_n.z) * settings.descent_dt_s + 1.0
+        swinging = swinging | (jnp.isfinite(trigger_time) & (t < settled + settings.swing_settle_s))
+    altitude, reach = -state.body.r_n.z, _reach_m(settings, state)
+    swung = reach + jnp.abs(state.body.v_n.z) * settings.swing_settle_s
     for jump_altitude in p.environment.wind.jump_altitudes_m():
         transient = transient | (jnp.abs(altitude - jump_altitude) < reach)
-    return any_open & ~transient
+        swinging = swinging | ((altitude < jump_altitude) & (jump_altitude - altitude < swung))
+    steady = any_open & ~transient
+    if not settings.point_mass_descent:
+        return steady, False
+    for trigger_gap in _trigger_gaps_m(p, state):
+        swinging = swinging | (jnp.abs(trigger_gap) < reach)
+    return steady, steady & ~swinging
+
+
+def _reach_m(settings: SimSettings, state: FlightState):
+    """How near a wind-layer boundary [m] a descent is a transient, and how near one or a trigger altitude a point mass
+    stops: one longest 6-DOF descent period's sink + 1 m."""
+    return jnp.abs(state.body.v_n.z) * settings.descent_dt_s + 1.0
+
+
+def _trigger_gaps_m(p: FlightParams, state: FlightState) -> list:
+    """Each parachute still to be triggered at an altitude: its trigger altitude minus the altitude [m] (with the
+    navigation's held height error when it triggers them), inf for the others."""
+    altitude = -state.body.r_n.z
+    sensed_error = 0.0 if state.gnc is None or state.gnc.recovery is None else state.gnc.recovery.height_error_m
+    pending = jnp.isfinite(state.events.apogee_time)
+    return [jnp.where(pending & jnp.isinf(trigger_time), chute.trigger_altitude_agl_m - altitude - sensed_error, jnp.inf)
+            for chute, trigger_time in zip(p.rocket.parachutes, state.events.chute_trigger_times)]  # fmt: skip
 
 
 def control_period(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState):
-    """The period starting at ``state`` [s]: ``settings.control_dt_s``; in steady descent under canopy
-    it grows up to ``settings.descent_dt_s`` while the body's pendulum rate ω allows RK4 steps with
-    h·ω ≤ ``settings.descent_h_omega``. Without a controller and sensors, a period in which the forces switch ends
-    there (``event_period``). Each realization keeps its own clock."""
-    stable_period = settings.substeps * settings.descent_h_omega / jnp.sqrt(jnp.maximum(state.canopy_stiffness, 1e-12))
-    descent_period = jnp.clip(stable_period, settings.control_dt_s, settings.descent_dt_s)
-    period = jnp.where(steady_descent(p, settings, state), descent_period, settings.control_dt_s)
-    if settings.event_periods and p.gnc is None and p.avionics is None:  # with them, each regular period is a GNC tick
+    """The period starting at ``state`` [s] and whether the body flies it as a point mass (bool, ``steady_descent``).
+
+    ``regular_period_s``; in steady descent under canopy it grows up to ``settings.descent_dt_s`` while the body's
+    pendulum rate ω allows RK4 steps with h·ω ≤ ``settings.descent_h_omega``; as a point mass up to
+    ``POINT_MASS_MAX_S`` while h·λ ≤ ``POINT_MASS_H_RATE``, λ the rate at which the canopies' quadratic drag settles
+    the air-relative velocity (``Canopy``), and ending where the point mass ends (``point_mass_period``). Without a
+    controller and sensors, a period in which the forces switch ends there (``event_period``). Each realization
+    keeps its own clock."""
+    regular = regular_period_s(p, settings)
+    steady, point_mass = steady_descent(p, settings, state)
+    stable_period = settings.substeps * settings.descent_h_omega / jnp.sqrt(jnp.maximum(state.canopy.stiffness, 1e-12))
+    descent_period = jnp.clip(stable_period, regular, max(settings.descent_dt_s, regular))
+    period = jnp.where(steady, descent_period, regular)
+    if point_mass is not False:
+        period = jnp.where(point_mass, point_mass_period(p, settings, state, descent_period), period)
+    if _events_end_periods(p, settings):
         period = event_period(p, start_n, state, period)
-    return period
+    return period, point_mass
+
+
+def point_mass_period(p: FlightParams, settings: SimSettings, state: FlightState, shortest):
+    """A point-mass period [s] (``control_period``), at least ``shortest`` [s] unless it ends first just inside
+    ``_reach_m`` of a wind-layer boundary or a trigger altitude, or just below the ground (each predicted at the
+    start's sink, overshot by ``EVENT_OVERSHOOT``): a long RK4 step must not reach across the wind's jump or the
+    opening, nor its stages far below the ground (where the low-altitude turbulence scales vanish)."""
+    altitude, climb = -state.body.r_n.z, -state.body.v_n.z
+    mean_wind_n, _, gust = period_gust(p, state)
+    drag_per_m, airspeed = state.canopy.drag_per_m, (state.body.v_n - mean_wind_n - gust).norm()
+    gravity = p.environment.gravity_mps2(p.environment.site_altitude_m + altitude)
+    rate = 2.0 * jnp.maximum(drag_per_m * airspeed, jnp.sqrt(gravity * drag_per_m))  # now, or at the terminal speed
+    period = jnp.clip(settings.substeps * POINT_MASS_H_RATE / jnp.maximum(rate, 1e-12), shortest, POINT_MASS_MAX_S)
+    reach = _reach_m(settings, state)
+    gaps = [jump - altitude + reach for jump in p.environment.wind.jump_altitudes_m()]
+    gaps += [gap + reach for gap in _trigger_gaps_m(p, state)] + [-altitude]
+    to_edge = functools.reduce(jnp.minimum, [_time_to(gap, climb) for gap in gaps], jnp.inf)
+    return jnp.minimum(to_edge + EVENT_OVERSHOOT * period, period)
+
+
+POINT_MASS_H_RATE = 2.0
+"""The largest RK4 step h of a point-mass period times the rate λ [1/s] at which quadratic drag settles the
+air-relative velocity v_air (gust included): 2κ|v_air| with κ = ``Canopy.drag_per_m``, or 2κ·v_t = 2√(gκ) at the
+terminal speed v_t = √(g/κ) if larger (a gust can leave the canopy nearly still in the air, and the period must stay
+stable as it falls back to v_t). RK4 is stable to h·λ = 2.8 on decaying modes."""
+POINT_MASS_MAX_S = 5.0
+"""The longest point-mass period [s]."""
+
+
+def regular_period_s(p: FlightParams, settings: SimSettings) -> float:
+    """A period's length outside steady descent [s], unless an event ends it first: ``settings.open_loop_dt_s``
+    without a controller and sensors when events end periods (``settings.event_periods``), else the GNC's
+    ``settings.control_dt_s``."""
+    return settings.open_loop_dt_s if _events_end_periods(p, settings) else settings.control_dt_s
+
+
+def _events_end_periods(p: FlightParams, settings: SimSettings) -> bool:
+    return settings.event_periods and p.gnc is None and p.avionics is None  # with them, each period is a GNC tick
 
 
 EVENT_OVERSHOOT = 0.01
@@ -104,8 +177,9 @@ def event_period(p: FlightParams, start_n: Vec3, state: FlightState, period):
     rail = p.launch.rail_direction_n
     travel = rail_travel_m(p) - (state.body.r_n - start_n).dot(rail)
     to_switch = jnp.where(jnp.isinf(state.events.rail_exit_time), _time_to(travel, state.body.v_n.dot(rail)), jnp.inf)
+    altitude, climb = -state.body.r_n.z, -state.body.v_n.z
     for boundary in p.environment.wind.jump_altitudes_m():
-        to_switch = jnp.minimum(to_switch, _time_to(boundary + state.body.r_n.z, -state.body.v_n.z))
+        to_switch = jnp.minimum(to_switch, _time_to(boundary - altitude, climb))
     to_kink = p.rocket.motor.ignition_time_s + p.rocket.motor.time_s - state.t
     to_kink = jnp.min(jnp.where(to_kink > CLOCK_RESOLUTION_S, to_kink, jnp.inf))
     return jnp.minimum(jnp.minimum(to_switch + EVENT_OVERSHOOT * period, to_kink), period)
@@ -129,11 +203,12 @@ def period_gust(p: FlightParams, state: FlightState):
 
 def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None,
-    first_stage: bool = False,
+    first_stage: bool = False, point_mass=False,
 ) -> tuple[FlightState, jnp.ndarray | None]:  # fmt: skip
     """One control period of ``period`` [s] (``control_period``) with the turbulent gust held: RK4 substeps
     of the rigid body with events, then the turbulence filters advanced over the period with ``noise``,
-    the period's row of turbulence noise (None without turbulence); ``tick`` + 1. Returns the new state and,
+    the period's row of turbulence noise (None without turbulence); ``tick`` + 1. point_mass (bool,
+    ``steady_descent``'s): the body's rates set to zero and its attitude held over the period. Returns the new state and,
     with ``first_stage``, the CG's acceleration [m/s², NED], the body's angular acceleration [rad/s², FRD], the
     dynamic pressure [Pa] and the CG's position x [m, body] at the period start (the first RK4 stage's), as one
     (8,) array, else None.
@@ -148,7 +223,7 @@ def control_step(
     sensed = None if recovery is None else (recovery.height_error_m, jnp.isfinite(recovery.apogee_time))
 
     def rhs(t, y, events):
-        d_body, diag = derivatives(t, y, p, deflections(t), gust, events)
+        d_body, diag = derivatives(t, y, p, deflections(t), gust, events, point_mass)
         if not first_stage:
             return d_body, (diag, None)
         # one array, not a pytree: RK4 keeps its first stage's by-products with a select per leaf and stage; the CG
@@ -161,10 +236,13 @@ def control_step(
         body1, (diag, derivative) = rk4_step(lambda t, y: rhs(t, y, events), t0, body0, h)
         body1 = normalize_attitude(body1)
         events = update_events(p, start_n, events, t0, h, body0, body1, diag, sensed)
-        return (t0 + h, body1, events, diag.canopy_stiffness), derivative
+        return (t0 + h, body1, events, diag.canopy), derivative
 
-    carry = (state.t, state.body, state.events, state.canopy_stiffness)
-    (t, body, events, stiffness), derivatives_at_start = jax.lax.scan(substep, carry, None, settings.substeps)
+    body = state.body
+    if point_mass is not False:
+        body = tree_where(point_mass, body._replace(omega_b=Vec3.zeros(state.t)), body)
+    carry = (state.t, body, state.events, state.canopy)
+    (t, body, events, canopy), derivatives_at_start = jax.lax.scan(substep, carry, None, settings.substeps)
     first = None if derivatives_at_start is None else jax.tree_util.tree_map(lambda x: x[0], derivatives_at_start)
     finite = functools.reduce(jnp.logical_and, [jnp.isfinite(x) for x in jax.tree_util.tree_leaves(body)])
     body = tree_where(done(state) | ~finite, state.body, body)
@@ -174,7 +252,7 @@ def control_step(
     if turbulence is not None:
         airspeed = (state.body.v_n - mean_wind_n - gust).norm()
         filters = advance_turbulence(filters, scales, airspeed, period, noise)
-    return FlightState(state.t + period, state.tick + 1, body, events, stiffness, filters, state.gnc, state.avionics), first
+    return FlightState(state.t + period, state.tick + 1, body, events, canopy, filters, state.gnc, state.avionics), first
 
 
 class StepNoise(NamedTuple):
@@ -193,14 +271,14 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when ``p.gnc`` is set:
     guidance and control at the period start, the servos' response inside it; navigating from the sensors, the
     LQI reads the canard feedback and the parachutes trigger on the navigation: ``gnc.control.navigate``)."""
-    period = control_period(p, settings, start_n, state)
-    sensing = period <= settings.control_dt_s  # the sensors sample in GNC periods only, not in long descent ones
+    period, point_mass = control_period(p, settings, start_n, state)
+    sensing = (period <= settings.control_dt_s) & ~jnp.asarray(point_mass)  # GNC periods only, not long or point-mass ones
     if p.gnc is None:
         held = jnp.zeros(p.rocket.aero.n_canards) if canard_command is None else canard_command(state.t)
         held = jnp.asarray(held, dtype=float)
         start = _sensed(p, state, held, sensing, noise)
         state, first = control_step(p, settings, start_n, start, period, lambda t: held, noise.turbulence,
-                                    p.avionics is not None)  # fmt: skip
+                                    p.avionics is not None, point_mass)  # fmt: skip
         return _accelerometer(p, start, state, first, sensing, noise)
     if canard_command is not None:
         raise ValueError("canard_command flies open loop: it needs a flight without a controller (p.gnc None)")
@@ -229,7 +307,7 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     servo = end_of_period(servo_params, held, period)
     state, first = control_step(p, settings, start_n, state, period,
                                 lambda t: deflection_at(servo_params, held, t - t0), noise.turbulence,
-                                p.avionics is not None)  # fmt: skip
+                                p.avionics is not None, point_mass)  # fmt: skip
     state = dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
     return _accelerometer(p, start, state, first, sensing, noise)
 

@@ -15,7 +15,7 @@ from ..dynamics.rigid_body import MassProperties, combine_on_axis
 from ..math import Quat, Vec3
 from ..pytree import tree_where
 from .params import FlightParams
-from .state import Diagnostics, Events
+from .state import Canopy, Diagnostics, Events
 
 def mass_properties(p: FlightParams, t) -> MassProperties:
     """Mass, CG and inertia of the rocket with the propellant left at time ``t``."""
@@ -33,8 +33,8 @@ def mass_properties(p: FlightParams, t) -> MassProperties:
 class Loads(NamedTuple):
     """What acts on the rocket at one instant (``loads``): its mass properties, the air data, the thrust
     along body x [N], the aerodynamic force at the moment reference [N, FRD], the parachutes' force [N, NED],
-    the moment of everything about the CG [N·m, FRD], whether a canopy is open (bool), the canopy ω²
-    [1/s²] and whether the aerodynamic tables were left (bool)."""
+    the moment of everything about the CG [N·m, FRD], whether a canopy is open (bool), the ``Canopy`` rates and
+    whether the aerodynamic tables were left (bool)."""
 
     mass: MassProperties
     air: AirData
@@ -43,7 +43,7 @@ class Loads(NamedTuple):
     chute_force_n: Vec3
     moment_b: Vec3
     under_canopy: jnp.ndarray
-    canopy_stiffness: jnp.ndarray
+    canopy: Canopy
     outside_tables: jnp.ndarray
 
 
@@ -62,7 +62,7 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
     force_n = Vec3.zeros(t)
     moment_b = Vec3.zeros(t)
     under_canopy = jnp.zeros_like(t, dtype=bool)
-    stiffness = jnp.zeros_like(t)
+    stiffness, drag_per_m = jnp.zeros_like(t), jnp.zeros_like(t)
     for chute, trigger_time in zip(rocket.parachutes, events.chute_trigger_times):
         fraction = open_fraction(chute, trigger_time, t)
         if chute.released_by is not None:  # cut away once the canopy that releases it starts opening
@@ -76,6 +76,7 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
         moment_b = moment_b + arm_b.cross(q_nb.rotate_inverse(drag_n))
         under_canopy = under_canopy | (fraction > 0.0)
         stiffness = stiffness + drag_n.norm() * jnp.abs(arm_b.x) / mass.iyy
+        drag_per_m = drag_per_m + drag_n.norm() / (mass.mass * jnp.maximum(v_air_n.dot(v_air_n), 1e-12))
 
     thrust_n = thrust(rocket.motor, t)
     coefficients, outside_tables = aero_coefficients(rocket.aero, air, omega_b, mass.cg_x, deflections, thrust_n > 0.0)
@@ -86,12 +87,14 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
     aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
-    return Loads(mass, air, thrust_n, aero_force_b, force_n, moment_b, under_canopy, stiffness, outside_tables)
+    return Loads(mass, air, thrust_n, aero_force_b, force_n, moment_b, under_canopy, Canopy(stiffness, drag_per_m), outside_tables)
 
 
-def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events):
+def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events,
+                point_mass=False):  # fmt: skip
     """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad] and a
-    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind."""
+    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind; point_mass (bool): the body's attitude and rates
+    held, its CG moved by every force (steady descent: ``sim.flight.steady_descent``)."""
     f = loads(t, body, p, deflections, gust_n, events)
     force_b = f.aero_force_b + Vec3(f.thrust_n, 0.0, 0.0)
     gravity = p.environment.gravity_mps2(p.environment.site_altitude_m - body.r_n.z)
@@ -104,5 +107,7 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     zero = jnp.zeros_like(accel_along)
     on_rail = RigidBodyState(body.v_n, rail * accel_along, Quat(zero, zero, zero, zero), Vec3(zero, zero, zero))
     d_body = tree_where(jnp.isinf(events.rail_exit_time), on_rail, free)
+    if point_mass is not False:
+        d_body = tree_where(point_mass, RigidBodyState(free.r_n, free.v_n, on_rail.q_nb, on_rail.omega_b), d_body)
     qbar_outside = jnp.where(f.outside_tables & ~f.under_canopy, f.air.qbar, 0.0)
-    return d_body, Diagnostics(f.air.mach, f.air.qbar, f.canopy_stiffness, qbar_outside)
+    return d_body, Diagnostics(f.air.mach, f.air.qbar, f.canopy, qbar_outside)

@@ -103,9 +103,12 @@ class SimSettings:
     control_dt_s: control period, the GNC rate [s]; substeps: RK4 steps per control period;
     descent_dt_s: the longer period used under a fully open canopy, once opening transients have
     settled (``settle_s`` after full opening); the GNC is idle then [s]; ``descent_h_omega``: the
-    largest RK4 step h times the body's pendulum rate ω under its canopies there;
-    event_periods: without a controller and sensors, end a period at the rail exit, a wind-layer boundary and a
-    thrust-curve point (``sim.flight.event_period``); False: the GNC grid's periods, as with a controller;
+    largest RK4 step h times the body's pendulum rate ω under its canopies there; point_mass_descent: once the body's
+    swing has died out there (``swing_settle_s`` [s] after the last opening settled and the last wind-layer boundary
+    crossed), fly it as a point mass in longer periods (``sim.flight.steady_descent``);
+    event_periods: without a controller and sensors, fly periods of ``open_loop_dt_s`` [s] (``control_dt_s`` unless the
+    campaign sets a longer one) that end at the rail exit, a wind-layer boundary and a thrust-curve point
+    (``sim.flight.event_period``); False: the GNC grid's periods, as with a controller;
     max_time_s: a flight not on the ground by then gets the status MAX_TIME;
     block_steps: control periods per chunk of work between checks that the whole batch has landed.
     """
@@ -115,6 +118,9 @@ class SimSettings:
     descent_dt_s: float = 0.25
     descent_h_omega: float = 1.0
     settle_s: float = 1.0
+    point_mass_descent: bool = True
+    swing_settle_s: float = 5.0
     event_periods: bool = True
+    open_loop_dt_s: float = 0.02
     max_time_s: float = 300.0
     block_steps: int = 100

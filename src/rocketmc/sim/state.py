@@ -74,15 +74,23 @@ class Events:
     non_finite: jnp.ndarray
 
 
+class Canopy(NamedTuple):
+    """What the open canopies do to the body at one instant: the squared rate of its swing under them,
+    ω² = Σ|F_chute|·|arm|/I [1/s²], and their drag per unit mass and squared airspeed, Σ|F_chute|/(m·|v_air|²) [1/m]
+    (quadratic drag settles the air-relative velocity v_air at a rate up to 2·that·|v_air| [1/s])."""
+
+    stiffness: jnp.ndarray
+    drag_per_m: jnp.ndarray
+
+
 @pytree_dataclass
 class FlightState:
-    """Time [s], the control-period counter, rigid-body state, the event record, the squared pendulum
-    rate of the body swinging under its canopies, ω² = Σ|F_chute|·|arm|/I [1/s²], which bounds the
-    descent step, the turbulence filters (None without turbulence), the closed loop's state (None
-    without a controller) and the avionics' (None without sensors).
+    """Time [s], the control-period counter, rigid-body state, the event record, the ``Canopy`` rates at the end
+    of the last period (they bound the descent's periods), the turbulence filters (None without turbulence), the
+    closed loop's state (None without a controller) and the avionics' (None without sensors).
 
-    tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A long period of
-    steady descent (``steady_descent``: up to ``settings.descent_dt_s``, the GNC idle) counts one too, as does,
+    tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A longer period of
+    steady descent (``steady_descent``: the GNC idle) counts one too, as does,
     without a controller and sensors, a period ending at an event (``sim.flight.event_period``), so with them
     ``t = tick·control_dt_s`` (up to the rounding of the summed periods) only until the first long period."""
 
@@ -90,19 +98,19 @@ class FlightState:
     tick: jnp.ndarray
     body: RigidBodyState
     events: Events
-    canopy_stiffness: jnp.ndarray
+    canopy: Canopy
     turbulence: TurbulenceState | None
     gnc: GncState | None = None
     avionics: AvionicsState | None = None
 
 
 class Diagnostics(NamedTuple):
-    """By-products of the right-hand side: Mach [-], dynamic pressure [Pa], canopy ω² [1/s²], and
+    """By-products of the right-hand side: Mach [-], dynamic pressure [Pa], the ``Canopy`` rates, and
     the dynamic pressure if the aerodynamic tables were left (not under a canopy), else 0 [Pa]."""
 
     mach: jnp.ndarray
     qbar: jnp.ndarray
-    canopy_stiffness: jnp.ndarray
+    canopy: Canopy
     qbar_outside_tables: jnp.ndarray
 
 
