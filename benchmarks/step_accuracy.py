@@ -29,7 +29,8 @@ def outputs(campaign) -> dict:
 
 def _steps(campaign) -> str:
     sim = campaign.config.simulation
-    return (f"periods {sim.control_dt_s:g} s, open loop {sim.open_loop_dt_s or sim.control_dt_s:g} s, descent up to {sim.descent_dt_s:g} s, "
+    return (f"periods {sim.control_dt_s:g} s, open loop {sim.open_loop_dt_s or sim.control_dt_s:g} s, "
+            f"descent up to {sim.descent_dt_s:g} s, "
             f"{sim.substeps} RK4 steps each{', point-mass descent' if sim.point_mass_descent else ''}")
 
 
@@ -41,7 +42,8 @@ def main() -> None:
     parser.add_argument("--reference", choices=("periods", "substeps"), default="periods")
     parser.add_argument("--calm", action="store_true", help="no turbulence in any realization")
     parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
-                        help="campaign values of the flights measured (not the reference's), e.g. simulation.descent_h_rate=2")
+                        help="campaign values (JSON) of the flights measured, not the reference's, e.g. "
+                             "simulation.open_loop_dt_s=0.04")
     args = parser.parse_args()
     campaign = load_campaign(args.campaign)
     calm = {}

@@ -33,7 +33,7 @@ from rocketmc.sim.outputs import METRICS, flight_summary, metric
 from rocketmc.sim.params import SimSettings
 from rocketmc.sim.state import Status
 
-N_PERIODS = 3000  # control periods flown by `fly`: past every landing (~1030 periods: 0.04 s up, up to 0.25 s under canopy)
+N_PERIODS = 3000  # periods flown by `fly`: past every landing (~800: 0.04 s up, up to 5 s under canopy)
 
 
 # ----------------------------------------------------------------------------- parameter variants

@@ -38,7 +38,8 @@ def sim_settings(campaign: Campaign) -> SimSettings:
     s = campaign.config.simulation
     return SimSettings(
         control_dt_s=s.control_dt_s, substeps=s.substeps, descent_dt_s=max(s.descent_dt_s, s.control_dt_s),
-        descent_h_omega=s.descent_h_omega, event_periods=s.event_periods, open_loop_dt_s=s.open_loop_dt_s or s.control_dt_s,
+        descent_h_omega=s.descent_h_omega, event_periods=s.event_periods,
+        open_loop_dt_s=s.open_loop_dt_s or s.control_dt_s,
         point_mass_descent=s.point_mass_descent, swing_settle_s=s.swing_settle_s, max_time_s=s.max_time_s,
     )
 

@@ -89,8 +89,9 @@ def _trigger_gaps_m(p: FlightParams, state: FlightState) -> list:
     altitude = -state.body.r_n.z
     sensed_error = 0.0 if state.gnc is None or state.gnc.recovery is None else state.gnc.recovery.height_error_m
     pending = jnp.isfinite(state.events.apogee_time)
-    return [jnp.where(pending & jnp.isinf(trigger_time), chute.trigger_altitude_agl_m - altitude - sensed_error, jnp.inf)
-            for chute, trigger_time in zip(p.rocket.parachutes, state.events.chute_trigger_times)]  # fmt: skip
+    chutes = zip(p.rocket.parachutes, state.events.chute_trigger_times)
+    return [jnp.where(pending & jnp.isinf(trigger), chute.trigger_altitude_agl_m - altitude - sensed_error, jnp.inf)
+            for chute, trigger in chutes]  # fmt: skip
 
 
 def control_period(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState):
@@ -98,8 +99,8 @@ def control_period(p: FlightParams, settings: SimSettings, start_n: Vec3, state:
 
     ``regular_period_s``; in steady descent under canopy it grows up to ``settings.descent_dt_s`` while the body's
     pendulum rate ω allows RK4 steps with h·ω ≤ ``settings.descent_h_omega``; as a point mass up to
-    ``POINT_MASS_MAX_S`` while h·λ ≤ ``POINT_MASS_H_RATE``, λ the rate at which the canopies' quadratic drag settles
-    the air-relative velocity (``Canopy``), and ending where the point mass ends (``point_mass_period``). Without a
+    ``POINT_MASS_MAX_S`` while h·λ ≤ ``POINT_MASS_H_RATE``, λ the rate at which the canopies' quadratic drag
+    settles the air-relative velocity (``Canopy``), and ending where the point mass ends (``point_mass_period``). Without a
     controller and sensors, a period in which the forces switch ends there (``event_period``). Each realization
     keeps its own clock."""
     regular = regular_period_s(p, settings)

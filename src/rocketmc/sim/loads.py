@@ -87,7 +87,8 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
     aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
-    return Loads(mass, air, thrust_n, aero_force_b, force_n, moment_b, under_canopy, Canopy(stiffness, drag_per_m), outside_tables)
+    canopy = Canopy(stiffness, drag_per_m)
+    return Loads(mass, air, thrust_n, aero_force_b, force_n, moment_b, under_canopy, canopy, outside_tables)
 
 
 def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events,
@@ -105,9 +106,10 @@ def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: V
     accel_along = free.v_n.dot(rail)
     accel_along = jnp.where((body.v_n.dot(rail) > 0.0) | (accel_along > 0.0), accel_along, 0.0)
     zero = jnp.zeros_like(accel_along)
-    on_rail = RigidBodyState(body.v_n, rail * accel_along, Quat(zero, zero, zero, zero), Vec3(zero, zero, zero))
+    still_q, still_omega = Quat(zero, zero, zero, zero), Vec3(zero, zero, zero)  # attitude and rates held
+    on_rail = RigidBodyState(body.v_n, rail * accel_along, still_q, still_omega)
     d_body = tree_where(jnp.isinf(events.rail_exit_time), on_rail, free)
     if point_mass is not False:
-        d_body = tree_where(point_mass, RigidBodyState(free.r_n, free.v_n, on_rail.q_nb, on_rail.omega_b), d_body)
+        d_body = tree_where(point_mass, RigidBodyState(free.r_n, free.v_n, still_q, still_omega), d_body)
     qbar_outside = jnp.where(f.outside_tables & ~f.under_canopy, f.air.qbar, 0.0)
     return d_body, Diagnostics(f.air.mach, f.air.qbar, f.canopy, qbar_outside)

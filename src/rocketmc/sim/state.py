@@ -76,8 +76,9 @@ class Events:
 
 class Canopy(NamedTuple):
     """What the open canopies do to the body at one instant: the squared rate of its swing under them,
-    ω² = Σ|F_chute|·|arm|/I [1/s²], and their drag per unit mass and squared airspeed, Σ|F_chute|/(m·|v_air|²) [1/m]
-    (quadratic drag settles the air-relative velocity v_air at a rate up to 2·that·|v_air| [1/s])."""
+    ω² = Σ|F_chute|·|arm|/I [1/s²], and their drag per unit mass and squared airspeed,
+    Σ|F_chute|/(m·|v_air|²) [1/m] (quadratic drag settles the air-relative velocity v_air at a rate up to
+    2·that·|v_air| [1/s])."""
 
     stiffness: jnp.ndarray
     drag_per_m: jnp.ndarray
