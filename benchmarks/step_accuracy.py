@@ -30,8 +30,8 @@ def outputs(campaign) -> dict:
 def _steps(campaign) -> str:
     sim = campaign.config.simulation
     return (f"periods {sim.control_dt_s:g} s, open loop {sim.open_loop_dt_s or sim.control_dt_s:g} s, "
-            f"descent up to {sim.descent_dt_s:g} s, "
-            f"{sim.substeps} RK4 steps each{', point-mass descent' if sim.point_mass_descent else ''}")
+            f"6-DOF descent up to {sim.descent_dt_s:g} s{', then a point mass up to 5 s' if sim.point_mass_descent else ''}, "
+            f"{sim.substeps} RK4 steps each")
 
 
 def main() -> None:
