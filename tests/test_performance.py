@@ -43,7 +43,8 @@ def cost():
     print(f"\none core: interpolated / simplified {r['interpolated_over_simplified']:.2f}x; closed loop "
           f"{1 / r['closed_over_open_loop']:.2f}x the open loop's flights/s; sensors "
           f"{r['sensors_over_closed_loop']:.2f}x the closed loop's cost; the full GNC "
-          f"{r['full_gnc_speed_over_open_loop']:.2f}x the open loop's flights/s")  # fmt: skip
+          f"{r['full_gnc_speed_over_open_loop']:.2f}x the open loop's flights/s on one grid, "
+          f"{r['full_gnc_speed_over_campaign_step']:.2f}x at the campaign's open-loop period")  # fmt: skip
     return r
 
 
@@ -65,7 +66,8 @@ def test_interpolated_costs_at_most_1_5x_the_simplified(cost):
 def test_closed_loop_flies_at_least_0_7x_the_open_loops_flights_per_second(cost):
     # 0.7x is the closed loop's bound: guidance, the gain lookup, u = −Kx and the servos' closed form at each RK4
     # stage, with perfect navigation, must not make the controller a luxury in a campaign. A per-step
-    # host callback, a Python branch that recompiles, or small-matrix algebra under vmap would break it.
+    # host callback, a Python branch that recompiles, or small-matrix algebra under vmap would break it. Both fly
+    # the controller's period: the open loop's longer periods (open_loop_dt_s) are a step choice, not a cost.
     flights_per_s = 1.0 / cost["closed_over_open_loop"]
     assert flights_per_s >= 0.7, f"the closed loop flies {flights_per_s:.2f}x the open loop's flights per second"
 
