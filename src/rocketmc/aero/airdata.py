@@ -7,7 +7,7 @@ from typing import NamedTuple
 import jax.numpy as jnp
 
 from ..env.atmosphere import AtmosphereState
-from ..math import Vec3
+from ..math import Vec3, safe_arctan2
 
 
 class AirData(NamedTuple):
@@ -28,7 +28,7 @@ def air_data(v_air_b: Vec3, atmosphere: AtmosphereState, altitude_msl) -> AirDat
     """Air data from the velocity relative to the air in the body frame [m/s]."""
     speed = v_air_b.norm()
     safe_speed = jnp.maximum(speed, 1e-9)
-    alpha = jnp.arctan2(v_air_b.z, v_air_b.x)
+    alpha = safe_arctan2(v_air_b.z, v_air_b.x)
     beta = jnp.arcsin(jnp.clip(v_air_b.y / safe_speed, -1.0, 1.0))
     return AirData(
         speed,

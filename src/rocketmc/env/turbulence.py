@@ -36,7 +36,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..math import Quat, Vec3
+from ..math import Quat, Vec3, safe_sqrt
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass
 
@@ -146,7 +146,7 @@ def high_altitude_scales(severity, height_m) -> DrydenScales:
 
 def _first_order_step(z, s, n):
     """Exact step of the unit-variance OU state over s = h/τ with a standard normal n."""
-    return jnp.exp(-s) * z + jnp.sqrt(-jnp.expm1(-2.0 * s)) * n
+    return jnp.exp(-s) * z + safe_sqrt(-jnp.expm1(-2.0 * s)) * n
 
 
 def _second_order_step(z1, z2, s, n1, n2):
@@ -161,9 +161,9 @@ def _second_order_step(z1, z2, s, n1, n2):
     q22 = one_minus_phi2
     q12 = (one_minus_phi2 - 2.0 * s * phi2) / _SQRT2
     q11 = one_minus_phi2 - 2.0 * s * phi2 * (1.0 + s)
-    l22 = jnp.sqrt(q22)
+    l22 = safe_sqrt(q22)
     l21 = q12 / jnp.where(l22 > 0.0, l22, 1.0)
-    l11 = jnp.sqrt(jnp.maximum(q11 - l21 * l21, 0.0))
+    l11 = safe_sqrt(jnp.maximum(q11 - l21 * l21, 0.0))
     return decay * (z1 + _SQRT2 * s * z2) + l21 * n2 + l11 * n1, decay * z2 + l22 * n2
 
 
@@ -235,12 +235,12 @@ def gust_n(state: TurbulenceState, scales: RegimeScales, mean_wind_n: Vec3, q_nb
     height, the mean wind there (its direction sets the low-altitude axes) and the attitude."""
     low = _gust_components(state.low, scales.low)
     high = _gust_components(state.high, scales.high)
-    speed = jnp.sqrt(mean_wind_n.x**2 + mean_wind_n.y**2)
+    speed = safe_sqrt(mean_wind_n.x**2 + mean_wind_n.y**2)
     calm = speed == 0.0
     c = jnp.where(calm, 1.0, mean_wind_n.x / jnp.where(calm, 1.0, speed))  # cos and sin of the heading the
     s = jnp.where(calm, 0.0, mean_wind_n.y / jnp.where(calm, 1.0, speed))  # mean wind blows toward (north if calm)
     low_n = Vec3(c * low.x - s * low.y, s * low.x + c * low.y, low.z)
-    return low_n * jnp.sqrt(1.0 - scales.blend) + q_nb.rotate(high) * jnp.sqrt(scales.blend)
+    return low_n * safe_sqrt(1.0 - scales.blend) + q_nb.rotate(high) * safe_sqrt(scales.blend)
 
 
 def advance_turbulence(state: TurbulenceState, scales: RegimeScales, speed_mps, dt_s, noise) -> TurbulenceState:

@@ -11,6 +11,8 @@ from typing import NamedTuple
 
 import jax.numpy as jnp
 
+from .safe import safe_sqrt
+
 
 class Vec3(NamedTuple):
     """A 3-vector in one frame; the frame is named by the variable (``v_n``, ``omega_b``)."""
@@ -44,7 +46,7 @@ class Vec3(NamedTuple):
         )
 
     def norm(self) -> jnp.ndarray:
-        return jnp.sqrt(self.dot(self))
+        return safe_sqrt(self.dot(self))
 
     def to_array(self) -> jnp.ndarray:
         """(3,) array (for tests and host code; avoid inside the right-hand side)."""
@@ -82,7 +84,7 @@ class Quat(NamedTuple):
         return Quat(self.w, -self.x, -self.y, -self.z)
 
     def norm(self) -> jnp.ndarray:
-        return jnp.sqrt(self.w**2 + self.x**2 + self.y**2 + self.z**2)
+        return safe_sqrt(self.w**2 + self.x**2 + self.y**2 + self.z**2)
 
     def normalized(self) -> Quat:
         n = self.norm()

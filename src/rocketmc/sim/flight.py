@@ -364,17 +364,40 @@ def _accelerometer(p: FlightParams, start: FlightState, state: FlightState, firs
 def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndarray]:
     """Fly until landed, stopped or ``settings.max_time_s``; return (summary dict, status code).
 
-    The loop runs in blocks of ``settings.block_steps`` control periods (``fly_block``).
+    The loop runs in blocks of ``settings.block_steps`` control periods (``fly_block``), as many as the flight
+    needs: a ``while_loop``, which forward-mode derivatives (``jax.jvp``) go through and reverse mode does not
+    (``simulate_bounded``).
     """
+    return flight_summary(p, _flown(p, settings)[0])
 
+
+def flight_blocks(p: FlightParams, settings: SimSettings):
+    """The number of blocks ``simulate_one`` flies (uint32): ``simulate_bounded``'s ``n_blocks`` for the flight."""
+    return _flown(p, settings)[1]
+
+
+def _flown(p: FlightParams, settings: SimSettings) -> tuple[FlightState, jnp.ndarray]:
     def block(carry):
         state, index = carry
         return fly_block(p, settings, state, index), index + 1
 
-    final, _ = jax.lax.while_loop(
+    return jax.lax.while_loop(
         lambda carry: ~flight_done(settings, carry[0]), block, (initial_state(p), jnp.zeros((), jnp.uint32))
     )
-    return flight_summary(p, final)
+
+
+def simulate_bounded(p: FlightParams, settings: SimSettings, n_blocks: int) -> tuple[dict, jnp.ndarray]:
+    """``simulate_one``'s flight in exactly ``n_blocks`` blocks: a ``scan``, through which reverse-mode derivatives
+    (``jax.grad``, ``jax.vjp``) go. A block after the flight's end leaves its state as it was, so with ``n_blocks``
+    at least ``flight_blocks`` the summary's bits are ``simulate_one``'s (too few: the flight is cut, status
+    MAX_TIME). Each block is rematerialised in the backward pass (``jax.checkpoint``): the memory a flight's gradient
+    holds is one state per block and one block's intermediates, as diffrax's checkpointed loops do."""
+
+    def block(state, index):
+        return tree_where(flight_done(settings, state), state, fly_block(p, settings, state, index)), None
+
+    blocks = jnp.arange(n_blocks, dtype=jnp.uint32)
+    return flight_summary(p, jax.lax.scan(jax.checkpoint(block), initial_state(p), blocks)[0])
 
 
 def flight_done(settings: SimSettings, state: FlightState):
