@@ -38,8 +38,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from .runtime import PRECISION
-from .ellipse import confidence_ellipse
+from .ellipse import chi2_scale, confidence_ellipse
 from .campaign import load_campaign, run_chunks, with_overrides
+from .campaign.derivatives import batch_function, ellipse_area_m2
 from .campaign.runner import GROUP, batch_size, chunking, compile_chunk, realization, realization_params, sim_settings
 from .sim.flight import fly, regular_period_s
 from .sim.state import Status, done
@@ -142,6 +143,33 @@ def costs(campaign, repeats: int = 3) -> dict:
             "full_gnc_speed_over_campaign_step": s["campaign_step"] / s["filters"]}  # fmt: skip
 
 
+GRADIENT_FLIGHTS = 1000
+"""Flights of the gradient's batch (``gradient_cost``)."""
+GRADIENT_PARAMS = ("rocket.dry_mass_kg", "rocket.aero.drag_scale", "launch.elevation_deg")
+"""The design numbers the bench's gradient is taken with respect to."""
+
+
+def gradient_cost(campaign, mode: str, repeats: int = 2) -> dict:
+    """The 95 % ellipse's area over ``GRADIENT_FLIGHTS`` flights of ``campaign`` (``derivatives.ellipse_area_m2``),
+    its forward pass (``mode`` "forward": the flights vmapped, ``simulate_one``) or its value and reverse-mode
+    gradient with respect to ``GRADIENT_PARAMS`` ("reverse": ``simulate_bounded``), compiled, then timed (best of ``repeats``, wall time [s]); the process's peak memory is the
+    caller's (``_measure``)."""
+    settings, master = sim_settings(campaign), jax.random.key(campaign.config.seed)
+    indices = jnp.arange(GRADIENT_FLIGHTS, dtype=jnp.uint32)
+    level_scale, shift = chi2_scale(0.95), jnp.zeros(len(GRADIENT_PARAMS))
+    t0 = time.perf_counter()
+    x0, flights = batch_function(campaign, settings, master, indices, GRADIENT_PARAMS, reverse=mode != "forward")
+    area = lambda s: ellipse_area_m2(*flights(x0 + s[None, :]), level_scale)  # noqa: E731  (a design change s)
+    run = jax.jit(area if mode == "forward" else jax.value_and_grad(area)).lower(shift).compile()
+    compile_s, seconds = time.perf_counter() - t0, []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        jax.block_until_ready(run(shift))
+        seconds.append(time.perf_counter() - t0)
+    return {"mode": mode, "flights": GRADIENT_FLIGHTS, "params": list(GRADIENT_PARAMS), "compile_s": compile_s,
+            "run_s": min(seconds)}  # fmt: skip
+
+
 PHASE_FLIGHTS = 32
 """Realizations whose control periods ``periods_by_phase`` counts."""
 
@@ -229,7 +257,9 @@ def _measure(spec: dict) -> dict:
 
 # --- orchestration (in the calling process) ------------------------------------------------------
 
-WHOLE_CAMPAIGN_KINDS = {"ratios": ratios, "costs": costs, "periods": periods_by_phase}
+WHOLE_CAMPAIGN_KINDS = {"ratios": ratios, "costs": costs, "periods": periods_by_phase,
+                        "forward_pass": lambda c, repeats: gradient_cost(c, "forward", repeats),
+                        "gradient": lambda c, repeats: gradient_cost(c, "reverse", repeats)}
 """The measurements of the campaign file as it is (no N, model or chunk size of their own), by kind: the ratios and
 costs time several flight functions together; the periods by phase count."""
 
@@ -372,6 +402,11 @@ def run_benchmarks(
         f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost, the full GNC (filters) "
         f"{c['full_gnc_speed_over_open_loop']:.2f}x the open loop's flights/s on one grid, "
         f"{c['full_gnc_speed_over_campaign_step']:.2f}x at the campaign's open-loop period")  # fmt: skip
+    forward, gradient = (measure(kind, path, precisions[0], repeats=2) for kind in ("forward_pass", "gradient"))
+    report["gradient"] = {"forward": forward, "reverse": gradient}
+    log(f"gradient of the ellipse's area over {gradient['flights']} flights ({precisions[0]}): "
+        f"{gradient['run_s'] / forward['run_s']:.1f}x the forward pass's time, "
+        f"{gradient['peak_rss_mb'] / forward['peak_rss_mb']:.1f}x its peak memory")  # fmt: skip
     return report
 
 
@@ -441,6 +476,14 @@ def format_report(report: dict) -> str:
         f"flights/s of the controller off ({1e3 * s['filters']:.2f} ms), "
         f"{c['full_gnc_speed_over_campaign_step']:.2f}x those flown at the campaign's open-loop period "
         f"({1e3 * s['campaign_step']:.2f} ms)"
+    )
+    forward, gradient = report["gradient"]["forward"], report["gradient"]["reverse"]
+    lines.append(
+        f"  the 95 % ellipse's area over {gradient['flights']} flights and its reverse-mode gradient with respect to "
+        f"{len(gradient['params'])} design numbers: {gradient['run_s']:.1f} s "
+        f"against {forward['run_s']:.1f} s for the forward pass ({gradient['run_s'] / forward['run_s']:.1f}x), "
+        f"peak memory {gradient['peak_rss_mb']:.0f} against {forward['peak_rss_mb']:.0f} MB; compiled in "
+        f"{gradient['compile_s']:.0f} and {forward['compile_s']:.0f} s"
     )
     return "\n".join(lines)
 

@@ -151,6 +151,42 @@ def _compare(args) -> int:
     return 0
 
 
+SENSITIVITY_CHUNK = 256
+"""``sensitivities``' realizations per chunk by default: a 256-flight chunk of lynx_ballistic's derivatives peaked at
+3.6 GB (compilation included), where a run's chunk of 1000 flights takes ~1 GB."""
+
+
+def _sensitivities(args) -> int:
+    from .analysis.sensitivities import format_sensitivities, plot_tornado, sensitivity_table
+    from .campaign.derivatives import check_inputs, default_inputs
+    from .campaign.run import run_campaign
+    from .files import file_stem
+
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    campaign = _campaign(args.campaign, n_realizations=args.n, seed=args.seed, **_switched(args))
+    dispersed = default_inputs(campaign)
+    named = [] if args.wrt is None else [path.strip() for path in args.wrt.split(",")]
+    wrt = dispersed + [path for path in named if path not in dispersed]
+    check_inputs(campaign, wrt)
+    if not wrt:
+        raise RocketmcError(f"{args.campaign}: no continuous dispersion to differentiate with respect to; name design "
+                            "numbers with --wrt")  # fmt: skip
+    out = args.out or f"{file_stem(campaign.config.name)}_sensitivities.h5"
+    progress = _progress(args.quiet)
+    progress(f"derivatives with respect to {len(wrt)} inputs ({len(dispersed)} dispersed), reverse mode: a flight's "
+             "derivatives and linearity check cost about 20 flights of a run")  # fmt: skip
+    try:
+        run_campaign(campaign, out, chunk_size=args.chunk_size or SENSITIVITY_CHUNK, resume=args.resume,
+                     force=args.force, progress=progress, warn=lambda line: _warn([line]), derivatives_wrt=wrt)  # fmt: skip
+    finally:
+        progress.end()
+    table = sensitivity_table(out)
+    print(json.dumps(table, indent=2) if args.json else format_sensitivities(table))
+    if plot:
+        print(f"wrote {plot_tornado(table, plot)}", file=sys.stderr)
+    return 0
+
+
 def _figure_suffixes() -> tuple[str, ...]:
     """The file suffixes matplotlib writes figures as (.png, .pdf, .svg, ...)."""
     from matplotlib.figure import Figure
@@ -554,6 +590,26 @@ def build_parser() -> argparse.ArgumentParser:
                          help="HDF5 result files, at least two; the first is the baseline")  # fmt: skip
     compare.add_argument("--json", action="store_true", help="print the comparison as JSON")
     compare.add_argument("--plot", help="write the impact points and 95 %% ellipses of all files to this PNG")
+    sensitivity = commands.add_parser(
+        "sensitivities", help="each flight's derivatives of its landing point, apogee and landing speed with respect "
+                              "to its inputs, and each dispersed input's share of their spread")  # fmt: skip
+    sensitivity.add_argument("campaign", help="campaign file (TOML)")
+    sensitivity.add_argument("-n", type=COUNT, help="number of realizations (overrides the campaign)")
+    sensitivity.add_argument("--seed", type=int, help="master seed (overrides the campaign)")
+    sensitivity.add_argument("--wrt", metavar="PATH,...",
+                             help="design numbers (dotted paths, e.g. rocket.dry_mass_kg) to differentiate with "
+                                  "respect to, besides every continuously dispersed input")  # fmt: skip
+    sensitivity.add_argument("--out", help="result file with /derivatives (default: <campaign name>_sensitivities.h5)")
+    sensitivity.add_argument("--chunk-size", type=COUNT,
+                             help=f"realizations per compiled batch (default {SENSITIVITY_CHUNK}: derivatives hold more "
+                                  "memory per flight than a run)")  # fmt: skip
+    sensitivity.add_argument("--json", action="store_true", help="print the shares as JSON")
+    sensitivity.add_argument("--plot", help="write the tornado plot of the shares to this PNG")
+    sensitivity.add_argument("--quiet", action="store_true", help="no progress messages (errors and warnings only)")
+    replace = sensitivity.add_mutually_exclusive_group()
+    replace.add_argument("--force", action="store_true", help="replace an existing result file")
+    replace.add_argument("--resume", action="store_true", help="complete the partial run left in OUT.partial/")
+    _flight_switches(sensitivity)
     aero = commands.add_parser("aero", help="aerodynamic coefficients of a rocket")
     aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
     derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")
@@ -724,7 +780,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("compare needs at least two result files")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget,
-               "motors": _motors, "import": _import}  # fmt: skip
+               "motors": _motors, "import": _import,
+               "sensitivities": _sensitivities}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

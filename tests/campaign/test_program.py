@@ -84,7 +84,7 @@ def test_a_structure_change_is_another_program(monkeypatch):
     assert len({structure_fingerprint(c) for c in [campaign, *changed]}) == 3
     lowered = []
     program = type("Program", (), {"compiled": lambda self, *args: object()})()
-    monkeypatch.setattr(runner, "_chunk_program", lambda c, batch: lowered.append(c) or program)
+    monkeypatch.setattr(runner, "_chunk_program", lambda c, batch, wrt: lowered.append(c) or program)
     monkeypatch.setattr(runner, "_compiled", runner.OrderedDict())
     for c in [campaign, *others]:
         runner.compiled_chunk(c, 16)

@@ -10,12 +10,14 @@ import numpy as np
 import pytest
 
 from rocketmc.campaign import load_campaign
-from rocketmc.campaign.derivatives import DIFFERENTIATED_OUTPUTS, check_inputs, jacobian, realization_function
+from rocketmc import ellipse
+from rocketmc.campaign.derivatives import (DIFFERENTIATED_OUTPUTS, check_inputs, ellipse_area_m2, jacobians,
+                                          realization_function)
 from rocketmc.campaign.errors import ConfigError
 from rocketmc.campaign.runner import realization_params, sim_settings
 from rocketmc.math import safe_arctan2, safe_sqrt
 from rocketmc.sensors.errors import quantize
-from rocketmc.sim.flight import flight_blocks, simulate_bounded, simulate_one
+from rocketmc.sim.flight import max_blocks, simulate_bounded, simulate_one
 
 from ..conftest import CAMPAIGNS
 
@@ -40,7 +42,7 @@ def _forward_and_differences(campaign, index: int):
     x0 = np.asarray(x0)[None, :]
     points = np.concatenate([np.tile(x0, (len(WRT), 1)), x0 + basis * h, x0 - basis * h])
     tangents = np.concatenate([basis, np.zeros_like(basis), np.zeros_like(basis)])
-    y, dy = jax.jit(jax.vmap(lambda x, dx: jax.jvp(f, (x,), (dx,))))(points, tangents)
+    y, dy = jax.jit(jax.vmap(lambda x, dx: jax.jvp(lambda z: f(z)[0], (x,), (dx,))))(points, tangents)
     n = len(WRT)
     return np.asarray(dy[:n]).T, np.asarray((y[n : 2 * n] - y[2 * n :]) / (2 * h[:, None])).T
 
@@ -75,27 +77,34 @@ def test_closed_loop_forward_derivatives_match_central_differences():
     assert max(errors) < 1e-6
 
 
-def test_reverse_mode_through_the_bounded_flight_equals_forward_mode(ballistic):
-    settings, master = sim_settings(ballistic), jax.random.key(ballistic.config.seed)
-    index = jnp.uint32(0)
-    n_blocks = int(jax.jit(lambda i: flight_blocks(realization_params(ballistic, master, i)[0], settings))(index))
-    forward = jax.jit(lambda i: jacobian(ballistic, settings, master, i, WRT))(index)
-    reverse = jax.jit(lambda i: jacobian(ballistic, settings, master, i, WRT, n_blocks))(index)
+def test_reverse_mode_through_the_bounded_flights_equals_forward_mode():
+    # the closed loop under parachutes: the canopies' triggers at an infinite altitude and the point mass's periods
+    # to an infinite gap, whose derivatives reverse mode multiplies by 0 (NaN until kept out of the divisions)
+    campaign = load_campaign(CAMPAIGNS / "lynx_nominal_ctrl_1s.toml")
+    settings, master = sim_settings(campaign), jax.random.key(campaign.config.seed)
+    indices = jnp.arange(2, dtype=jnp.uint32)
+
+    def forward(index):
+        x0, f = realization_function(campaign, settings, master, index, WRT)
+        return jax.jacfwd(lambda x: f(x)[0])(x0)
+
+    expected = jax.jit(jax.vmap(forward))(indices)
+    summary, status, reverse = jax.jit(lambda i: jacobians(campaign, settings, master, i, WRT))(indices)
+    assert np.all(np.asarray(status) == 0)
     # the same derivatives summed in another order: round-off only
-    np.testing.assert_allclose(reverse[1], forward[1], rtol=1e-9, atol=1e-9 * np.abs(forward[1]).max())
+    np.testing.assert_allclose(reverse, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
 
 
-def test_bounded_flight_keeps_simulate_ones_bits(ballistic):
+def test_bounded_flights_keep_simulate_ones_bits(ballistic):
     settings, master = sim_settings(ballistic), jax.random.key(ballistic.config.seed)
     params = lambda i: realization_params(ballistic, master, i)[0]  # noqa: E731
     indices = jnp.arange(8, dtype=jnp.uint32)
-    n_blocks = int(jax.jit(jax.vmap(lambda i: flight_blocks(params(i), settings)))(indices).max())
     one = jax.jit(jax.vmap(lambda i: simulate_one(params(i), settings)))(indices)
-    bounded = jax.jit(jax.vmap(lambda i: simulate_bounded(params(i), settings, n_blocks + 2)))(indices)
+    bounded = jax.jit(lambda i: simulate_bounded(params, i, settings, max_blocks(settings)))(indices)
     for name, value in one[0].items():
         np.testing.assert_array_equal(np.asarray(bounded[0][name]), np.asarray(value), err_msg=name)
     np.testing.assert_array_equal(np.asarray(bounded[1]), np.asarray(one[1]))
-    cut = jax.jit(jax.vmap(lambda i: simulate_bounded(params(i), settings, 2)))(indices)
+    cut = jax.jit(lambda i: simulate_bounded(params, i, settings, 2))(indices)
     assert np.all(np.asarray(cut[1]) != 0)  # too few blocks: cut short, not landed
 
 
@@ -124,3 +133,17 @@ def test_quantizer_is_straight_through():
     x, lsb = jnp.array([-0.26, 0.0, 0.24, 0.26]), 0.5
     np.testing.assert_array_equal(quantize(x, lsb), jnp.array([-0.5, 0.0, 0.0, 0.5]))
     np.testing.assert_array_equal(jax.vmap(jax.grad(quantize), (0, None))(x, lsb), jnp.ones(4))
+
+
+def test_ellipse_area_weights_failed_flights_out_and_matches_the_reports():
+    rng = np.random.default_rng(4)
+    points = rng.normal(size=(50, 4)) * np.array([300.0, 120.0, 1.0, 1.0])
+    status = np.zeros(50, dtype=np.int32)
+    status[[3, 7]] = 3
+    points[7, :2] = np.nan  # a failed flight without an impact point
+    ok = status == 0
+    expected = ellipse.ellipse_area_m2(points[ok, 0], points[ok, 1])
+    got = ellipse_area_m2(jnp.asarray(points), jnp.asarray(status), ellipse.chi2_scale(0.95))
+    assert got == pytest.approx(expected, rel=1e-12)
+    gradient = jax.grad(lambda x: ellipse_area_m2(x, jnp.asarray(status), 1.0))(jnp.asarray(points))
+    assert np.all(np.isfinite(gradient)) and np.all(gradient[~ok] == 0.0)

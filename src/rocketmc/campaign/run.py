@@ -10,6 +10,7 @@ whatever the chunk size, the machine count or the resumes.
 
 from __future__ import annotations
 
+import functools
 import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -19,6 +20,7 @@ from ..errors import RocketmcError
 from ..files import file_stem
 from .checks import VALIDITY_OUTPUTS, outputs_validity_warnings, preflight_warnings
 from ..ellipse import AreaConvergence
+from .derivatives import check_inputs
 from .flights import check_realization, trajectories
 from .record import Campaign
 from .runner import chunking, run_chunks
@@ -60,7 +62,7 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
                  resume: bool = False, force: bool = False, until_converged_pct: float | None = None,
                  trajectories_of: Sequence[int] = (), trajectory_interval_s: float = TRAJECTORY_INTERVAL_S,
                  executor: Callable = run_chunks, progress: Callable[..., None] = _silent,
-                 warn: Callable[[str], None] = _warn) -> Path:  # fmt: skip
+                 warn: Callable[[str], None] = _warn, derivatives_wrt: Sequence[str] = ()) -> Path:  # fmt: skip
     """Fly ``campaign`` and write its result file; returns its path (default: ``<campaign name>.h5``).
 
     chunk_size: realizations flown and committed together (default: the campaign's ``simulation.chunk_size``);
@@ -71,7 +73,9 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
     executor: flies chunks, ``runner.run_chunks`` or ``distributed.run_chunks`` bound to a Dask client;
     progress(line, transient): progress lines (transient ones may be overwritten by the next);
     warn(line): the campaign's and the flights' warnings, and a resume with nothing left to fly (by default
-    Python warnings of ``RunWarning``).
+    Python warnings of ``RunWarning``); derivatives_wrt: inputs (dotted paths, ``derivatives.check_inputs``) each
+    flight's derivatives are taken with respect to, written to ``/derivatives`` (``runner.chunk_function``; the
+    local executor only).
     Raises RocketmcError (one line) for what cannot be run or written; a killed run keeps its finished chunks.
     """
     cfg = campaign.config
@@ -81,7 +85,12 @@ def run_campaign(campaign: Campaign, out: str | Path | None = None, *, chunk_siz
     chunk_size, n_chunks = chunking(campaign, chunk_size)
     kept = kept_trajectories(campaign, trajectories_of)
     asked = {"realizations": kept, "interval_s": trajectory_interval_s} if kept else None
-    writer = ResultWriter(out, campaign, chunk_size, resume=resume, trajectories=asked)
+    wrt = tuple(derivatives_wrt)
+    if wrt:
+        check_inputs(campaign, wrt)
+        executor = functools.partial(executor, wrt=wrt)
+    writer = ResultWriter(out, campaign, chunk_size, resume=resume, trajectories=asked,
+                          derivatives=list(wrt) if wrt else None)  # fmt: skip
     try:
         if writer.already_complete:
             warn(f"{out}: complete already (the same campaign and options); nothing to resume")

@@ -17,7 +17,7 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import jax
 import jax.numpy as jnp
@@ -32,6 +32,7 @@ from .record import Campaign
 from .program import Program, cached_program, program_numbers, structure_fingerprint, with_numbers
 from .model import flight_params
 from .sampling import realization_key, sample_dispersions, sample_faults
+from .derivatives import DIFFERENTIATED_OUTPUTS, MISMATCH, sensitivities
 
 
 def sim_settings(campaign: Campaign) -> SimSettings:
@@ -127,30 +128,38 @@ def simulate_queue(params_of: Callable[[jnp.ndarray], FlightParams], queue, sett
     return carry[4], carry[5]
 
 
-def chunk_function(campaign: Campaign) -> Callable:
+def chunk_function(campaign: Campaign, wrt: tuple[str, ...] = ()) -> Callable:
     """The jitted chunk function of the campaign's structure (``program.structure_fingerprint``): (numbers, the master
-    key's data, indices (batch,)) -> (summary, status, inputs), the numbers ``program.program_numbers``'. The batch
-    is split evenly over the local devices (the CPU cores, see ``rocketmc.__init__``) with ``shard_map``; each device
-    flies its share on ``GROUP`` lanes and stops when its own flights are done."""
+    key's data, indices (batch,)) -> (summary, status, inputs, derivatives), the numbers ``program.program_numbers``'.
+    The batch is split evenly over the local devices (the CPU cores, see ``rocketmc.__init__``) with ``shard_map``;
+    each device flies its share on ``GROUP`` lanes and stops when its own flights are done. With ``wrt`` (dotted
+    paths), each flight also gives its derivatives with respect to them (``derivatives.sensitivities``: a dict of
+    each differentiated output's (batch, len(wrt)) and the linearity check's ``mismatch`` (batch, outputs)), the
+    device's flights side by side to the last one's landing, not queued; without, derivatives is an empty dict."""
     settings = sim_settings(campaign)
 
     def chunk(numbers, key_data, indices):
         flying, master_key = with_numbers(campaign, numbers), jax.random.wrap_key_data(key_data)
         drawn = jax.vmap(lambda i: realization_params(flying, master_key, i)[1])(indices)
-        params_of = lambda i: realization_params(flying, master_key, i)[0]  # noqa: E731
-        return *simulate_queue(params_of, indices, settings, GROUP), drawn
+        if not wrt:
+            params_of = lambda i: realization_params(flying, master_key, i)[0]  # noqa: E731
+            return *simulate_queue(params_of, indices, settings, GROUP), drawn, {}
+        summary, status, derivatives, mismatch = sensitivities(flying, settings, master_key, indices, wrt)
+        by_output = {name: derivatives[:, k] for k, name in enumerate(DIFFERENTIATED_OUTPUTS)}
+        return summary, status, drawn, {**by_output, MISMATCH: mismatch}
 
     P, mesh = jax.sharding.PartitionSpec, jax.sharding.Mesh(np.array(jax.local_devices()), ("batch",))
     return jax.jit(jax.shard_map(chunk, mesh=mesh, in_specs=(P(), P(), P("batch")), out_specs=P("batch"),
                                  check_vma=False))  # fmt: skip
 
 
-def _chunk_program(campaign: Campaign, batch: int) -> Program:
-    """``chunk_function`` exported once per structure, batch and device count into the cache folder
+def _chunk_program(campaign: Campaign, batch: int, wrt: tuple[str, ...] = ()) -> Program:
+    """``chunk_function`` exported once per structure, batch, device count and ``wrt`` into the cache folder
     (``program.cached_program``), and jitted from that export whether it was made now or read back."""
     P = jax.sharding.PartitionSpec
-    return cached_program("chunk", structure_fingerprint(campaign), chunk_function(campaign),
-                          *_example_arguments(campaign, batch), in_specs=(P(), P(), P("batch")), out_spec=P("batch"))  # fmt: skip
+    key = structure_fingerprint(campaign) + ("" if not wrt else "-wrt-" + ",".join(wrt))
+    return cached_program("chunk", key, chunk_function(campaign, wrt), *_example_arguments(campaign, batch),
+                          in_specs=(P(), P(), P("batch")), out_spec=P("batch"))  # fmt: skip
 
 
 def _example_arguments(campaign: Campaign, batch: int) -> tuple:
@@ -165,31 +174,34 @@ def lower_chunk(campaign: Campaign, batch: int) -> jax.stages.Lowered:
 
 
 def _bound(compiled: Callable, campaign: Campaign) -> Callable:
-    """``compiled`` with the campaign's numbers bound: (master_key, indices) -> (summary, status, inputs)."""
+    """``compiled`` with the campaign's numbers bound: (master_key, indices) -> (summary, status, inputs,
+    derivatives)."""
     numbers = program_numbers(campaign)
     return lambda master_key, indices: compiled(numbers, jax.random.key_data(master_key), indices)
 
 
-def compile_chunk(campaign: Campaign, batch: int) -> Callable:
-    """``lower_chunk(campaign, batch)`` compiled, the campaign's numbers bound: (master_key, indices) -> (summary,
-    status, inputs)."""
-    return _bound(_chunk_program(campaign, batch).compiled(*_example_arguments(campaign, batch)), campaign)
+def compile_chunk(campaign: Campaign, batch: int, wrt: tuple[str, ...] = ()) -> Callable:
+    """``lower_chunk(campaign, batch)`` compiled (with derivatives with respect to ``wrt``: ``chunk_function``), the
+    campaign's numbers bound: (master_key, indices) -> (summary, status, inputs, derivatives)."""
+    return _bound(_chunk_program(campaign, batch, wrt).compiled(*_example_arguments(campaign, batch)), campaign)
 
 
 COMPILED_KEPT = 4
 """Compiled chunk programs a process keeps (the most recently used): a Dask worker's successive
 chunks and runs, a notebook's or a test's runs of campaigns of one structure, compile once."""
 
-_compiled: OrderedDict[tuple[str, int], Callable] = OrderedDict()
+_compiled: OrderedDict[tuple[str, int, tuple[str, ...]], Callable] = OrderedDict()
 _compile_lock = threading.Lock()
 
 
-def compiled_chunk(campaign: Campaign, batch: int) -> Callable:
-    """``compile_chunk(campaign, batch)``, its program kept per process by the campaign's structure
-    (``program.structure_fingerprint``) and the batch; one compilation at a time, whatever the process's threads."""
-    key = structure_fingerprint(campaign), batch
+def compiled_chunk(campaign: Campaign, batch: int, wrt: tuple[str, ...] = ()) -> Callable:
+    """``compile_chunk(campaign, batch, wrt)``, its program kept per process by the campaign's structure
+    (``program.structure_fingerprint``), the batch and ``wrt``; one compilation at a time, whatever the process's
+    threads."""
+    key = structure_fingerprint(campaign), batch, wrt
     with _compile_lock:
-        compiled = _compiled.pop(key, None) or _chunk_program(campaign, batch).compiled(*_example_arguments(campaign, batch))
+        compiled = _compiled.pop(key, None) or _chunk_program(campaign, batch, wrt).compiled(
+            *_example_arguments(campaign, batch))
         _compiled[key] = compiled  # the most recently used last
         while len(_compiled) > COMPILED_KEPT:
             _compiled.popitem(last=False)
@@ -198,12 +210,14 @@ def compiled_chunk(campaign: Campaign, batch: int) -> Callable:
 
 @dataclass
 class ChunkResult:
-    """Host arrays of one chunk (rows ``start .. start + len``)."""
+    """Host arrays of one chunk (rows ``start .. start + len``): its outputs, drawn inputs, the time it took [s] and,
+    in a run with derivatives, each differentiated output's derivatives (rows, inputs) and the ``MISMATCH``."""
 
     start: int
     outputs: dict[str, np.ndarray]
     inputs: dict[str, np.ndarray]
     seconds: float
+    derivatives: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def chunking(campaign: Campaign, chunk_size: int | None = None) -> tuple[int, int]:
@@ -221,16 +235,19 @@ def fly_chunk(compiled: Callable, campaign: Campaign, chunk_size: int, batch: in
     indices = np.arange(start, start + batch, dtype=np.uint32)
     master_key = jax.random.key(campaign.config.seed)
     t0 = time.perf_counter()
-    summary, status, drawn = jax.block_until_ready(compiled(master_key, indices))
+    summary, status, drawn, derivatives = jax.block_until_ready(compiled(master_key, indices))
     keep = min(chunk_size, n - start)
     outputs = {k: np.asarray(v)[:keep] for k, v in summary.items()}
     outputs["status"] = np.asarray(status)[:keep]
     inputs = {k: np.asarray(v)[:keep] for k, v in drawn.items()}
-    return ChunkResult(start, outputs, inputs, time.perf_counter() - t0)
+    derivatives = {k: np.asarray(v)[:keep] for k, v in derivatives.items()}
+    return ChunkResult(start, outputs, inputs, time.perf_counter() - t0, derivatives)
 
 
-def run_chunks(campaign: Campaign, chunk_size: int | None = None, chunks: list[int] | None = None):
-    """Yield ``ChunkResult`` for each chunk index (all chunks by default), in order.
+def run_chunks(campaign: Campaign, chunk_size: int | None = None, chunks: list[int] | None = None,
+               wrt: tuple[str, ...] = ()):  # fmt: skip
+    """Yield ``ChunkResult`` for each chunk index (all chunks by default), in order, with derivatives with respect
+    to ``wrt`` (``chunk_function``).
 
     The first item yielded is the compile time [s] (a float, ~0 when this process compiled the
     campaign's chunk before); then one ChunkResult per chunk.
@@ -238,7 +255,7 @@ def run_chunks(campaign: Campaign, chunk_size: int | None = None, chunks: list[i
     chunk_size, n_chunks = chunking(campaign, chunk_size)
     t0 = time.perf_counter()
     batch = batch_size(chunk_size)
-    compiled = compiled_chunk(campaign, batch)
+    compiled = compiled_chunk(campaign, batch, wrt)
     yield time.perf_counter() - t0
     for c in range(n_chunks) if chunks is None else chunks:
         yield fly_chunk(compiled, campaign, chunk_size, batch, c)

@@ -11,8 +11,8 @@ the same way) and removes the folder: a file at ``<out>`` is complete.
 against the set-up given: a manifest of another set-up or edited by hand, a chunk of another set-up,
 one renamed, truncated or damaged, or a file that is not the run's are refused in one line, and
 nothing is overwritten.
-A run that keeps trajectories (``rocketmc run --trajectories``) says which in its manifest (a resume must ask for
-the same) and writes them in ``finish()``, into the file before it is marked complete: a run killed while flying
+A run that keeps trajectories (``rocketmc run --trajectories``) or derivatives (``rocketmc sensitivities``) says which
+in its manifest (a resume must ask for the same) and writes them in ``finish()``, into the file before it is marked complete: a run killed while flying
 them keeps its chunks and resumes to fly them again.
 One run at a time writes a partial folder: the writer holds an exclusive lock (``flock``) on its ``run.lock`` from
 the start to the end, which the system releases when the process ends, however it ends; a second run on the same
@@ -37,6 +37,7 @@ from ..sim.state import Status
 from .record import Campaign
 from .fingerprint import differences, fingerprint, setup
 from .flights import TRAJECTORY_RULE
+from .derivatives import DIFFERENTIATED_OUTPUTS, LINEARITY_STEP, MISMATCH
 from .runner import ChunkResult, chunking
 
 MANIFEST = "manifest.json"
@@ -45,10 +46,19 @@ LOCK = "run.lock"
 MANIFEST_FORMAT = 2
 """Version of the partial folder's layout: 2 since the set-up fingerprint (rocketmc 0.1)."""
 CHUNK_FILE = re.compile(r"chunk_(\d{6})\.h5")
-GROUPS = ("outputs", "inputs")
-"""The groups of a chunk file and of the result file."""
+GROUPS = ("outputs", "inputs", "derivatives")
+"""The groups of a chunk file and of the result file; "derivatives" only in a run with derivatives
+(``rocketmc sensitivities``): each differentiated output's derivatives, (rows, inputs), and the linearity check's
+mismatch, (rows, outputs)."""
 TRAJECTORIES = "trajectories"
 """The result file's group of kept trajectories (``run --trajectories``), absent when none were asked for."""
+DERIVATIVES_DESCRIPTION = (
+    "each flight's derivatives of its outputs (attribute outputs, one dataset each, rows × inputs) with respect to "
+    "its inputs (attribute wrt), its gusts and sensor errors held; NaN where the output is")
+MISMATCH_DESCRIPTION = (
+    "the linearity check per flight and output (columns: the group's outputs): the flights with every dispersed "
+    f"input moved by ±{100 * LINEARITY_STEP:g} % of its spread against the derivatives' prediction, |half difference − J·d| / √Σ(J_k d_k)²; "
+    "near 0 where the flight is smooth there, of order 1 where a discontinuity lies within the step")
 SHOWN_DIFFERENCES = 4
 """Differing set-up fields a refusal names before '...'."""
 
@@ -85,11 +95,13 @@ class ResultWriter:
 
     ``trajectories``: the realizations whose trajectories the file keeps and their sample interval,
     ``{"realizations": [i, ...], "interval_s": s}`` (None: none), kept in the manifest.
+    ``derivatives``: the inputs (dotted paths) the chunks' derivatives are taken with respect to (None: a run
+    without derivatives), kept in the manifest.
     ``already_complete``: resuming found no partial folder but a complete result file at ``out`` of
-    the same set-up and trajectories, which is kept (``finish()`` does nothing)."""
+    the same set-up, trajectories and derivatives, which is kept (``finish()`` does nothing)."""
 
     def __init__(self, out: str | Path, campaign: Campaign, chunk_size: int, resume: bool = False,
-                 trajectories: dict | None = None):  # fmt: skip
+                 trajectories: dict | None = None, derivatives: list[str] | None = None):  # fmt: skip
         self.out = Path(out)
         self.dir = partial_dir(self.out)
         self.n = campaign.config.n_realizations
@@ -101,6 +113,9 @@ class ResultWriter:
         self.trajectories = trajectories
         if trajectories is not None:  # absent otherwise: the manifests of runs without trajectories are unchanged
             self.manifest["trajectories"] = trajectories
+        self.derivatives = derivatives
+        if derivatives is not None:
+            self.manifest["derivatives"] = derivatives
         self.already_complete = False
         self._chunks: set[int] = set()  # indices of the chunks written and checked
         self._names: dict[str, set[str]] | None = None  # the datasets of every chunk, from the first checked
@@ -168,6 +183,8 @@ class ResultWriter:
                 kept = f.get(TRAJECTORIES)
                 kept = None if kept is None else {"realizations": kept.attrs["realizations"].tolist(),
                                                   "interval_s": float(kept.attrs["interval_s"])}  # fmt: skip
+                derived = f.get("derivatives")
+                derived = None if derived is None else json.loads(derived.attrs["wrt"])
         except (OSError, KeyError):  # KeyError: a /trajectories group without what was asked for, not rocketmc's
             raise ResumeError(f"{self.out}: no partial run {self.dir.name} to resume, and not a result file") from None
         if not complete:
@@ -178,6 +195,9 @@ class ResultWriter:
         if kept != self.trajectories:
             raise ResumeError(f"{self.out}: complete already, keeping other trajectories than asked (--trajectories, "
                               "--trajectory-interval); nothing to resume")  # fmt: skip
+        if derived != self.derivatives:
+            raise ResumeError(f"{self.out}: complete already, with derivatives with respect to other inputs than asked "
+                              "(--wrt); nothing to resume")  # fmt: skip
 
     def _check_manifest(self, found: dict) -> None:
         if found == self.manifest:
@@ -250,7 +270,9 @@ class ResultWriter:
         try:
             with replacing_hdf5(path, libver="latest") as f:  # checksummed datasets stored compactly (HDF5 ≥ 1.10)
                 f.attrs.update({"fingerprint": self.fingerprint, "chunk_index": chunk_index, "start": chunk.start})
-                for group, data in zip(GROUPS, (chunk.outputs, chunk.inputs)):
+                for group, data in zip(GROUPS, (chunk.outputs, chunk.inputs, chunk.derivatives)):
+                    if not data and group == "derivatives":
+                        continue
                     g = f.create_group(group)
                     for name, values in data.items():
                         g.create_dataset(name, data=values, fletcher32=True)
@@ -290,8 +312,12 @@ class ResultWriter:
                     "setup": json.dumps({k: v for k, v in self.setup.items() if k != "campaign_toml"}),
                     "overrides": json.dumps(self.overrides),
                 })  # fmt: skip
-                for group in GROUPS:
+                for group in GROUPS[:2]:
                     f.create_group(group)
+                if self.derivatives is not None:
+                    f.create_group("derivatives").attrs.update({
+                        "wrt": json.dumps(self.derivatives), "outputs": json.dumps(list(DIFFERENTIATED_OUTPUTS)),
+                        "description": DERIVATIVES_DESCRIPTION})  # fmt: skip
                 for index in needed:  # each chunk checked again: it could have changed since it was written
                     start = index * self.chunk_size
                     for group, data in self._read_chunk(index).items():
@@ -328,9 +354,14 @@ class ResultWriter:
         g = f.require_group(group)
         if name not in g:
             fill = 0 if np.issubdtype(like.dtype, np.integer) else np.nan
-            ds = g.create_dataset(name, shape=(n,), dtype=like.dtype, fillvalue=fill)
+            ds = g.create_dataset(name, shape=(n, *like.shape[1:]), dtype=like.dtype, fillvalue=fill)
             if group == "outputs":
                 ds.attrs["unit"], ds.attrs["description"] = metric(name)
+            if group == "derivatives" and name != MISMATCH:
+                ds.attrs["unit"] = f"{metric(name).unit} per unit of each input (the group's wrt)"
+                ds.attrs["description"] = f"derivatives of {name}: {metric(name).meaning}"
+            if name == MISMATCH:
+                ds.attrs["unit"], ds.attrs["description"] = "1", MISMATCH_DESCRIPTION
             if name == "status":
                 ds.attrs["codes"] = json.dumps({str(int(s)): s.message for s in Status})
         return g[name]

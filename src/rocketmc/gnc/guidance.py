@@ -13,6 +13,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0
+from ..math import safe_sqrt
 from ..math.vectors import Quat, Vec3
 from ..pytree import pytree_dataclass
 
@@ -82,7 +83,7 @@ def reference_direction(params: GuidanceParams, nav: Navigation, t) -> Vec3:
 
 def _clip_norm2(y, z, limit):
     """(y, z) scaled down to a 2-norm of at most ``limit``, direction kept."""
-    norm = jnp.sqrt(y * y + z * z)
+    norm = safe_sqrt(y * y + z * z)
     scale = jnp.where(norm > limit, limit / jnp.where(norm > 0.0, norm, 1.0), 1.0)
     return y * scale, z * scale
 

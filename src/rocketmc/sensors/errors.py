@@ -20,6 +20,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
+from ..math import safe_sqrt
 from ..pytree import pytree_dataclass, static_field
 
 
@@ -111,7 +112,7 @@ def white_std(channel: Channel, qbar):
     if channel.vibration is None:
         return channel.noise_std
     shaking = channel.vibration * qbar
-    return shaking if channel.noise_std is None else jnp.sqrt(channel.noise_std**2 + shaking**2)
+    return shaking if channel.noise_std is None else safe_sqrt(channel.noise_std**2 + shaking**2)
 
 
 def corrupt(channel: Channel, truth, walk, noise, qbar=0.0):

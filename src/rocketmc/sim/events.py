@@ -4,6 +4,7 @@ measured from (``rail_start_n``)."""
 
 from __future__ import annotations
 
+import jax
 import jax.numpy as jnp
 
 from ..dynamics import RigidBodyState
@@ -12,10 +13,23 @@ from .loads import mass_properties
 from .params import FlightParams
 from .state import Diagnostics, Events
 
+@jax.custom_jvp
 def _crossing_fraction(g0, g1):
-    """Fraction of a step at which g (linear in the step) reaches 0 from above; 0 if already there."""
+    """Fraction s = g0/(g0 − g1) of a step at which g (linear in the step) reaches 0 from above, in [0, 1]; 0 if
+    already there. Its derivative is taken inside (0, 1) only, where g0 and g1 are finite (``_crossing_jvp``): a
+    trigger at an infinite altitude makes g infinite in the branch not taken, and reverse mode multiplies that
+    branch's derivative by 0 (0·inf is NaN)."""
     dg = g0 - g1
     return jnp.clip(jnp.where(g0 > 0.0, g0 / jnp.where(dg != 0.0, dg, 1.0), 0.0), 0.0, 1.0)
+
+
+@_crossing_fraction.defjvp
+def _crossing_jvp(primals, tangents):
+    (g0, g1), (dg0, dg1) = primals, tangents
+    s = _crossing_fraction(g0, g1)
+    inside = (s > 0.0) & (s < 1.0) & (g1 < 0.0)  # g0 > 0 > g1, both finite
+    a, b = jnp.where(inside, g0, 1.0), jnp.where(inside, g1, -1.0)
+    return s, jnp.where(inside, (a * dg1 - b * dg0) / (a - b) ** 2, 0.0)  # ds = (g0·dg1 − g1·dg0) / (g0 − g1)²
 
 
 def _lerp(a, b, s):

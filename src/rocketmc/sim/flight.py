@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
+from collections.abc import Callable
 from typing import NamedTuple
 
 import jax
@@ -21,7 +23,7 @@ from ..dynamics.rigid_body import normalize_attitude
 from ..dynamics.servo import deflection_at, end_of_period
 from ..env import advance_turbulence, gust_n, initial_turbulence, turbulence_noise, turbulence_scales
 from ..gnc.control import gnc_step, initial_gnc, navigate, track_navigation
-from ..math import Vec3, rk4_step
+from ..math import Vec3, rk4_step, safe_sqrt
 from ..sensors.avionics import avionics_noise, initial_avionics, sense, sense_acceleration, specific_force_b
 from ..pytree import tree_where
 from .events import rail_start_n, rail_travel_m, update_events
@@ -124,7 +126,7 @@ def point_mass_period(p: FlightParams, settings: SimSettings, state: FlightState
     mean_wind_n, _, gust = period_gust(p, state)
     drag_per_m, airspeed = state.canopy.drag_per_m, (state.body.v_n - mean_wind_n - gust).norm()
     gravity = p.environment.gravity_mps2(p.environment.site_altitude_m + altitude)
-    rate = 2.0 * jnp.maximum(drag_per_m * airspeed, jnp.sqrt(gravity * drag_per_m))  # now, or at the terminal speed
+    rate = 2.0 * jnp.maximum(drag_per_m * airspeed, safe_sqrt(gravity * drag_per_m))  # now, or at the terminal speed
     period = jnp.clip(settings.substeps * POINT_MASS_H_RATE / jnp.maximum(rate, 1e-12), shortest, POINT_MASS_MAX_S)
     reach = _reach_m(settings, state)
     gaps = [jump - altitude + reach for jump in p.environment.wind.jump_altitudes_m()]
@@ -187,8 +189,10 @@ def event_period(p: FlightParams, start_n: Vec3, state: FlightState, period):
 
 
 def _time_to(gap, speed):
-    """Time [s] to close ``gap`` [m] at ``speed`` [m/s] along it; inf when moving away or still."""
-    return jnp.where(gap * speed > 0.0, gap / jnp.where(speed != 0.0, speed, 1.0), jnp.inf)
+    """Time [s] to close ``gap`` [m] at ``speed`` [m/s] along it; inf when moving away or still, or for an infinite
+    gap (kept out of the division, whose derivative there would be inf: reverse mode's 0·inf)."""
+    closing = (gap * speed > 0.0) & jnp.isfinite(gap)
+    return jnp.where(closing, jnp.where(closing, gap, 0.0) / jnp.where(closing, speed, 1.0), jnp.inf)
 
 
 def period_gust(p: FlightParams, state: FlightState):
@@ -368,36 +372,47 @@ def simulate_one(p: FlightParams, settings: SimSettings) -> tuple[dict, jnp.ndar
     needs: a ``while_loop``, which forward-mode derivatives (``jax.jvp``) go through and reverse mode does not
     (``simulate_bounded``).
     """
-    return flight_summary(p, _flown(p, settings)[0])
 
-
-def flight_blocks(p: FlightParams, settings: SimSettings):
-    """The number of blocks ``simulate_one`` flies (uint32): ``simulate_bounded``'s ``n_blocks`` for the flight."""
-    return _flown(p, settings)[1]
-
-
-def _flown(p: FlightParams, settings: SimSettings) -> tuple[FlightState, jnp.ndarray]:
     def block(carry):
         state, index = carry
         return fly_block(p, settings, state, index), index + 1
 
-    return jax.lax.while_loop(
+    final, _ = jax.lax.while_loop(
         lambda carry: ~flight_done(settings, carry[0]), block, (initial_state(p), jnp.zeros((), jnp.uint32))
     )
+    return flight_summary(p, final)
 
 
-def simulate_bounded(p: FlightParams, settings: SimSettings, n_blocks: int) -> tuple[dict, jnp.ndarray]:
-    """``simulate_one``'s flight in exactly ``n_blocks`` blocks: a ``scan``, through which reverse-mode derivatives
-    (``jax.grad``, ``jax.vjp``) go. A block after the flight's end leaves its state as it was, so with ``n_blocks``
-    at least ``flight_blocks`` the summary's bits are ``simulate_one``'s (too few: the flight is cut, status
-    MAX_TIME). Each block is rematerialised in the backward pass (``jax.checkpoint``): the memory a flight's gradient
-    holds is one state per block and one block's intermediates, as diffrax's checkpointed loops do."""
+def simulate_bounded(params_of: Callable[..., FlightParams], inputs, settings: SimSettings,
+                     n_blocks: int) -> tuple[dict, jnp.ndarray]:  # fmt: skip
+    """``simulate_one``'s flights of ``params_of(input)`` for a batch of inputs (a pytree with a leading flight axis),
+    in at most ``n_blocks`` blocks: a ``scan`` with a fixed number of steps, through which reverse-mode derivatives
+    (``jax.grad``, ``jax.vjp``) go, each block skipped once every flight of the batch is done (``lax.cond`` on the
+    whole batch). A flight done keeps its state, so with enough blocks (``max_blocks``) the summaries' bits are
+    ``simulate_one``'s (too few: the flights still up are cut, status MAX_TIME). Each block and each period in it
+    are rematerialised in the backward pass (``jax.checkpoint``): a gradient holds one state per block, one per
+    period of the block being differentiated and one period's intermediates, for each flight, as diffrax's
+    checkpointed loops do. The parameters are made per flight inside each block, so that what the flights share
+    (tables, thrust curve) stays one array, and no derivative is taken with respect to it."""
+    fly_all = jax.vmap(lambda i, state, index: fly_block(params_of(i), settings, state, index, True),
+                       in_axes=(0, 0, None))  # fmt: skip
+    done_all = jax.vmap(lambda state: flight_done(settings, state))
 
-    def block(state, index):
-        return tree_where(flight_done(settings, state), state, fly_block(p, settings, state, index)), None
+    def block(states, index):
+        done = done_all(states)
+        flown = lambda states: jax.vmap(tree_where)(done, states, fly_all(inputs, states, index))  # noqa: E731
+        return jax.lax.cond(jnp.all(done), lambda states: states, flown, states), None
 
     blocks = jnp.arange(n_blocks, dtype=jnp.uint32)
-    return flight_summary(p, jax.lax.scan(jax.checkpoint(block), initial_state(p), blocks)[0])
+    final, _ = jax.lax.scan(jax.checkpoint(block), jax.vmap(lambda i: initial_state(params_of(i)))(inputs), blocks)
+    return jax.vmap(lambda i, state: flight_summary(params_of(i), state))(inputs, final)
+
+
+def max_blocks(settings: SimSettings) -> int:
+    """Blocks enough for any flight to reach ``settings.max_time_s`` (``simulate_bounded``): its regular periods (the
+    shortest there are, but the few an event ends early) and two blocks' margin for those."""
+    shortest = min(settings.control_dt_s, settings.open_loop_dt_s)
+    return math.ceil(settings.max_time_s / shortest / settings.block_steps) + 2
 
 
 def flight_done(settings: SimSettings, state: FlightState):
@@ -405,12 +420,14 @@ def flight_done(settings: SimSettings, state: FlightState):
     return done(state) | (state.t >= settings.max_time_s)
 
 
-def fly_block(p: FlightParams, settings: SimSettings, state: FlightState, index) -> FlightState:
+def fly_block(p: FlightParams, settings: SimSettings, state: FlightState, index, remat: bool = False) -> FlightState:
     """The flight ``settings.block_steps`` control periods (block ``index`` of its flight) later,
-    canards neutral."""
+    canards neutral; remat: each period rematerialised in a backward pass (``jax.checkpoint``: one state kept
+    per period, not its intermediates)."""
     start_n = rail_start_n(p)
     noise = block_noise(p, index, settings.block_steps)
-    return jax.lax.scan(lambda s, n: (step(p, settings, start_n, s, n), None), state, noise, settings.block_steps)[0]
+    period = lambda s, n: (step(p, settings, start_n, s, n), None)  # noqa: E731
+    return jax.lax.scan(jax.checkpoint(period) if remat else period, state, noise, settings.block_steps)[0]
 
 
 def block_noise(p: FlightParams, index, n_periods: int) -> StepNoise:
