@@ -95,14 +95,20 @@ def test_reverse_mode_through_the_bounded_flights_equals_forward_mode():
     np.testing.assert_allclose(reverse, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
 
 
-def test_bounded_flights_keep_simulate_ones_bits(ballistic):
+def test_bounded_flights_fly_simulate_ones_flights(ballistic):
     settings, master = sim_settings(ballistic), jax.random.key(ballistic.config.seed)
     params = lambda i: realization_params(ballistic, master, i)[0]  # noqa: E731
     indices = jnp.arange(8, dtype=jnp.uint32)
     one = jax.jit(jax.vmap(lambda i: simulate_one(params(i), settings)))(indices)
     bounded = jax.jit(lambda i: simulate_bounded(params, i, settings, max_blocks(settings)))(indices)
     for name, value in one[0].items():
-        np.testing.assert_array_equal(np.asarray(bounded[0][name]), np.asarray(value), err_msg=name)
+        # round-off: the two programs compile the events' interpolation differently since the crossing's custom
+        # derivative (measured: 3 apogees of 8 one ulp apart, another output 18 ulp of a value smaller than its
+        # largest); 1e-13 of each output's largest value is 1e-10 m on a 1 km apogee
+        got, want = np.asarray(bounded[0][name]), np.asarray(value)
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(want), err_msg=name)
+        scale = np.nanmax(np.abs(want)) if np.isfinite(want).any() else 0.0
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-13 * scale, equal_nan=True, err_msg=name)
     np.testing.assert_array_equal(np.asarray(bounded[1]), np.asarray(one[1]))
     cut = jax.jit(lambda i: simulate_bounded(params, i, settings, 2))(indices)
     assert np.all(np.asarray(cut[1]) != 0)  # too few blocks: cut short, not landed

@@ -13,7 +13,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0
-from ..math import safe_sqrt
+from ..math import safe_arctan2, safe_sqrt
 from ..math.vectors import Quat, Vec3
 from ..pytree import pytree_dataclass
 
@@ -104,7 +104,7 @@ def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.
     d = reference_direction(params, nav, t)
     cross = v.cross(d)
     sin_part = cross.norm()
-    chi = jnp.arctan2(sin_part, v.dot(d))
+    chi = safe_arctan2(sin_part, v.dot(d))
     axis_n = cross * (1.0 / jnp.where(sin_part > 0.0, sin_part, 1.0))
     axis_b = nav.q_nb.rotate_inverse(axis_n)
     fly = guidance_active(params, t)
@@ -112,7 +112,7 @@ def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.
     q_cmd, r_cmd = _clip_norm2(params.gain * chi * axis_b.y, params.gain * chi * axis_b.z, params.rate_limit_rad_s)
     ch, sh = jnp.cos(params.roll_heading_rad), jnp.sin(params.roll_heading_rad)
     target_b = nav.q_nb.rotate_inverse(Vec3(ch, sh, jnp.zeros_like(ch)))
-    roll_error = jnp.arctan2(-target_b.y, target_b.z)
+    roll_error = safe_arctan2(-target_b.y, target_b.z)
     p_cmd = jnp.clip(params.roll_gain * roll_error, -params.roll_rate_limit_rad_s, params.roll_rate_limit_rad_s)
     command = Vec3(jnp.where(fly, p_cmd, 0.0), jnp.where(steer, q_cmd, 0.0), jnp.where(steer, r_cmd, 0.0))
     return command, chi

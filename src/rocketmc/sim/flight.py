@@ -388,8 +388,8 @@ def simulate_bounded(params_of: Callable[..., FlightParams], inputs, settings: S
     """``simulate_one``'s flights of ``params_of(input)`` for a batch of inputs (a pytree with a leading flight axis),
     in at most ``n_blocks`` blocks: a ``scan`` with a fixed number of steps, through which reverse-mode derivatives
     (``jax.grad``, ``jax.vjp``) go, each block skipped once every flight of the batch is done (``lax.cond`` on the
-    whole batch). A flight done keeps its state, so with enough blocks (``max_blocks``) the summaries' bits are
-    ``simulate_one``'s (too few: the flights still up are cut, status MAX_TIME). Each block and each period in it
+    whole batch). A flight done keeps its state, so with enough blocks (``max_blocks``) the summaries are
+    ``simulate_one``'s, to round-off (too few: the flights still up are cut, status MAX_TIME). Each block and each period in it
     are rematerialised in the backward pass (``jax.checkpoint``): a gradient holds one state per block, one per
     period of the block being differentiated and one period's intermediates, for each flight, as diffrax's
     checkpointed loops do. The parameters are made per flight inside each block, so that what the flights share
