@@ -13,6 +13,7 @@ from .loads import mass_properties
 from .params import FlightParams
 from .state import Diagnostics, Events
 
+
 @jax.custom_jvp
 def _crossing_fraction(g0, g1):
     """Fraction s = g0/(g0 − g1) of a step at which g (linear in the step) reaches 0 from above, in [0, 1]; 0 if
