@@ -208,7 +208,7 @@ def test_help_matches_the_readme(capsys):
     documented = _readme_commands()
     assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
                                ("sensors", "simulate"), ("navigate",), ("fly",), ("validate",), ("bench",),
-                               ("budget",), ("motors",), ("import",), ("sensitivities",)}  # fmt: skip
+                               ("budget",), ("motors",), ("import",), ("sensitivities",), ("tune",)}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]

@@ -187,6 +187,87 @@ def _sensitivities(args) -> int:
     return 0
 
 
+def _tune(args) -> int:
+    from .campaign import ConfigError
+    from .campaign.loader import with_overrides
+    from .analysis.plots import plot_tuning
+    from .campaign.tuning import TRAINING_SEED_OFFSET, check_parameters, evaluate, rounded, tune, tuned_campaign_text
+
+    plot = None if args.plot is None else _output_file("--plot", args.plot, _figure_suffixes())
+    out = _output_file("--out", args.out, (".toml",))
+    if out.exists() and not args.force:
+        raise RocketmcError(f"--out {out}: exists (--force replaces it)")
+    if args.objective == "apogee_error" and args.apogee_target_m is None:
+        raise RocketmcError("--apogee-target-m: needed by --objective apogee_error")
+    campaign = _campaign(args.campaign, **_switched(args))
+    given = [item.strip().partition("=") for item in args.params.split(",") if item.strip()]
+    paths = [path.strip() for path, _, _ in given]
+    starts = {path.strip(): _number(f"--params {path.strip()}", start) for path, _, start in given if start}
+    if "gnc.guidance.wind_gain" in paths and "gnc.guidance.wind_gain" not in campaign.nominal:
+        starts.setdefault("gnc.guidance.wind_gain", 1.0)  # off unless set: from the wind itself moving the reference
+    try:
+        campaign = with_overrides(campaign, values=starts) if starts and campaign.config.gnc is not None else campaign
+        check_parameters(campaign, paths)
+    except ConfigError as e:
+        raise RocketmcError(f"{args.campaign}: {e}") from None
+    progress = _progress(args.quiet)
+    try:
+        tuning = tune(campaign, paths, args.objective, args.train, args.steps, args.learning_rate,
+                      args.apogee_target_m, args.train_turbulence, progress)  # fmt: skip
+        values = rounded(tuning.tuned)
+        calm = "" if args.train_turbulence else " without turbulence"
+        comment = (f"Guidance tuned by `rocketmc tune` ({args.objective}, {args.train} training flights{calm} of seed "
+                   f"{campaign.config.seed + TRAINING_SEED_OFFSET}, {args.steps} Adam steps of {args.learning_rate:g}, "
+                   f"the lowest training objective at step {tuning.best}) from {Path(args.campaign).name}.")  # fmt: skip
+        out.write_text(tuned_campaign_text(campaign, Path(args.campaign), out, values, comment))
+        tuned = _campaign(str(out), **_switched(args))
+        held_out = {}
+        if args.test:
+            target = args.apogee_target_m
+            runs = {"controller off": with_overrides(campaign, controller=False), "start": campaign, "tuned": tuned}
+            for label, run in runs.items():
+                progress(f"held out: {args.test} flights of seed {campaign.config.seed}, {label}")
+                held_out[label] = evaluate(run, args.objective, args.test, target)
+    finally:
+        progress.end()
+    result = {"campaign": args.campaign, "objective": args.objective, "train": args.train, "steps": args.steps,
+              "best_step": tuning.best, "initial": dict(zip(paths, tuning.values[0].tolist())), "tuned": values,
+              "training_objective": tuning.objective.tolist(), "held_out": held_out, "out": str(out)}  # fmt: skip
+    print(json.dumps(result, indent=2, allow_nan=False) if args.json else _tuning_text(result))
+    if plot:
+        print(f"wrote {plot_tuning(tuning, held_out, plot)}", file=sys.stderr)
+    return 0
+
+
+def _number(field: str, text: str) -> float:
+    """``text`` as a finite number, else a one-line RocketmcError naming ``field``."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise RocketmcError(f"{field}: expected a number after '=', got {text!r}")
+    return value
+
+
+def _tuning_text(result: dict) -> str:
+    area = result["objective"] == "ellipse_area"
+    shown = lambda value: f"{value / 1e6:.3f} km²" if area else f"{value:.1f} m"  # noqa: E731
+    history = result["training_objective"]
+    lines = [f"{result['objective']} over {result['train']} training flights: {shown(history[0])} at the start, "
+             f"{shown(history[result['best_step']])} at step {result['best_step']} of {result['steps']}"]  # fmt: skip
+    lines += [f"  {path:36s} {result['initial'][path]:10.4g} -> {value:.4g}" for path, value in result["tuned"].items()]
+    if result["held_out"]:
+        base = result["held_out"]["controller off"]["value"]
+        lines.append("held out (the campaign's own seed):")
+        for label, r in result["held_out"].items():
+            change = "the baseline" if label == "controller off" else f"{100 * (r['value'] / base - 1):+.1f} % against it"
+            lines.append(f"  {label:15s} {shown(r['value']):>12s} ({change}), mean apogee {r['apogee_mean_m']:.0f} m, "
+                         f"{r['failed']} failed")  # fmt: skip
+    lines.append(f"wrote {result['out']}")
+    return "\n".join(lines)
+
+
 def _figure_suffixes() -> tuple[str, ...]:
     """The file suffixes matplotlib writes figures as (.png, .pdf, .svg, ...)."""
     from matplotlib.figure import Figure
@@ -610,6 +691,33 @@ def build_parser() -> argparse.ArgumentParser:
     replace.add_argument("--force", action="store_true", help="replace an existing result file")
     replace.add_argument("--resume", action="store_true", help="complete the partial run left in OUT.partial/")
     _flight_switches(sensitivity)
+    tuner = commands.add_parser("tune", help="tune the controller's guidance numbers by gradient descent through a "
+                                             "batch of training flights, and write the tuned campaign")  # fmt: skip
+    tuner.add_argument("campaign", help="campaign file (TOML) with a [gnc] section")
+    tuner.add_argument("--params", required=True, metavar="PATH[=START],...",
+                       help="guidance numbers to tune, each from the campaign's value or from START, e.g. "
+                            "gnc.guidance.gain,gnc.guidance.wind_gain=4 (the upwind aim, off unless set, from 1 "
+                            "without START); a gradient finds the nearest minimum: start where a coarse scan is lowest")  # fmt: skip
+    tuner.add_argument("--objective", choices=("ellipse_area", "apogee_error"), default="ellipse_area",
+                       help="the 95 %% landing ellipse's area, or the apogee's RMS error to --apogee-target-m")
+    tuner.add_argument("--apogee-target-m", type=_bounded(float, 0.0, MAX_ALTITUDE_M, "a height above the pad", above=True),
+                       help="the target of --objective apogee_error [m above the pad]")  # fmt: skip
+    tuner.add_argument("--train", type=COUNT, default=256, help="training flights (default 256; the campaign's seed + 1)")
+    tuner.add_argument("--test", type=_bounded(int, 0, None, "0 or more"), default=1000,
+                       help="held-out flights (the campaign's own seed) flown before and after, and with the "
+                            "controller off (default 1000; 0: none)")  # fmt: skip
+    tuner.add_argument("--train-turbulence", action="store_true",
+                       help="train on flights with the campaign's turbulence (by default without: its gusts make the "
+                            "objective jump where a derivative sees none)")  # fmt: skip
+    tuner.add_argument("--steps", type=COUNT, default=30, help="Adam steps (default 30)")
+    tuner.add_argument("--learning-rate", type=_bounded(float, 0.0, 1.0, "in (0, 1]", above=True), default=0.05,
+                       help="Adam's step, in units of each number's starting value (default 0.05)")
+    tuner.add_argument("--out", required=True, help="the tuned campaign file to write (.toml; extends CAMPAIGN)")
+    tuner.add_argument("--force", action="store_true", help="replace an existing --out")
+    tuner.add_argument("--plot", help="write the objective's history and the tuned numbers to this PNG")
+    tuner.add_argument("--json", action="store_true", help="print the result as JSON")
+    tuner.add_argument("--quiet", action="store_true", help="no progress messages (errors and warnings only)")
+    _flight_switches(tuner)
     aero = commands.add_parser("aero", help="aerodynamic coefficients of a rocket")
     aero_commands = aero.add_subparsers(dest="aero_command", required=True, parser_class=_Parser)
     derivatives = aero_commands.add_parser("derivatives", help="linear coefficients at a Mach number")
@@ -781,7 +889,7 @@ def main(argv: list[str] | None = None) -> int:
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget,
                "motors": _motors, "import": _import,
-               "sensitivities": _sensitivities}  # fmt: skip
+               "sensitivities": _sensitivities, "tune": _tune}  # fmt: skip
     try:
         return command[args.command](args)
     except RocketmcError as e:  # bad input, a partial run or cluster that cannot be used, a full disk

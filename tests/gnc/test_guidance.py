@@ -22,10 +22,12 @@ from rocketmc.campaign.schema import GuidanceConfig
 from rocketmc.env.atmosphere import G0
 from rocketmc.gnc.guidance import (
     Navigation,
+    filtered_wind,
     guidance_active,
     integrate_errors,
     rate_command,
     reference_direction,
+    wind_estimate,
 )
 from rocketmc.math.vectors import Quat, Vec3
 
@@ -228,3 +230,54 @@ def test_vmap_matches_jit_bit_for_bit_and_eager_to_rounding():
         assert [float(x[i]) for x in batched] == compiled
         eager = [float(x) for x in jax.tree_util.tree_leaves(step(*one))]
         np.testing.assert_allclose(eager, compiled, rtol=1e-14, atol=1e-14)
+
+
+def test_wind_estimate_recovers_the_wind_at_zero_angle_of_attack():
+    """An airframe whose axis lies along its air velocity v − w (zero angle of attack) gives back the horizontal
+    wind w exactly (to rounding); an axis shallower than 30° gives 0 (the estimate would divide by its climb)."""
+    wind = Vec3(-4.0, 7.0, 0.0)
+    v = Vec3(20.0, -5.0, -150.0)
+    air = v - wind
+    pitch = math.atan2(-air.z, math.hypot(air.x, air.y))
+    yaw = math.atan2(air.y, air.x)
+    got = wind_estimate(nav(v, Quat.from_euler(yaw, pitch, 0.3)))
+    np.testing.assert_allclose([float(got.x), float(got.y), float(got.z)], [wind.x, wind.y, 0.0], atol=ROUND * 150)
+    shallow = wind_estimate(nav(Vec3(100.0, 0.0, -10.0), Quat.from_euler(0.0, 20 * DEG, 0.0)))
+    assert [float(c) for c in shallow] == [0.0, 0.0, 0.0]
+
+
+def test_filtered_wind_is_the_first_order_lag_of_the_estimate():
+    """A constant estimate ŵ through n periods dt of the low-pass τ from 0: ŵ (1 − e^(−n dt/τ)), the closed form."""
+    wind = Vec3(-4.0, 7.0, 0.0)
+    v = Vec3(20.0, -5.0, -150.0)
+    air = v - wind
+    attitude = Quat.from_euler(math.atan2(air.y, air.x), math.atan2(-air.z, math.hypot(air.x, air.y)), 0.0)
+    filtered = Vec3(0.0, 0.0, 0.0)
+    for _ in range(37):
+        filtered = filtered_wind(filtered, nav(v, attitude), 0.02, 2.0)
+    expected = np.array([wind.x, wind.y]) * -math.expm1(-37 * 0.02 / 2.0)
+    np.testing.assert_allclose([float(filtered.x), float(filtered.y)], expected, rtol=1e-12)  # 37 steps' rounding
+
+
+def test_upwind_aim_moves_the_reference_against_the_wind():
+    """wind_gain k_w: d_ref is the direction of (v_x cos ψ − k_w w_n, v_x sin ψ − k_w w_e, −(c1 − g0 (t − t0)));
+    k_w = 0 is the thesis's reference to rounding (its own formula, not its bits); before liftoff (t = −inf) the
+    aimed reference is its direction at t = 0, the thesis's straight up, both with finite derivatives."""
+    wind = Vec3(6.0, -3.0, 0.0)
+    k_w, t = 2.0, 4.0
+    aimed = dataclasses.replace(THESIS, wind_gain=jnp.asarray(k_w), wind_time_constant_s=jnp.asarray(2.0))
+    c1 = math.sqrt(2 * G0 * 1614.0)
+    v_x, climb = c1 / math.tan(84 * DEG), c1 - G0 * (t - 1.5)
+    expected = np.array([v_x * math.cos(130 * DEG) - k_w * wind.x, v_x * math.sin(130 * DEG) - k_w * wind.y, -climb])
+    got = reference_direction(aimed, None, jnp.asarray(t), wind).to_array()
+    np.testing.assert_allclose(got, expected / np.linalg.norm(expected), atol=ROUND)
+    calm = dataclasses.replace(aimed, wind_gain=jnp.asarray(0.0))
+    np.testing.assert_allclose(reference_direction(calm, None, jnp.asarray(t), wind).to_array(),
+                               reference_direction(THESIS, None, jnp.asarray(t)).to_array(), atol=ROUND)  # fmt: skip
+    before = reference_direction(aimed, None, jnp.asarray(-jnp.inf), wind).to_array()
+    np.testing.assert_array_equal(before, reference_direction(aimed, None, jnp.asarray(0.0), wind).to_array())
+    for guidance in (aimed, THESIS):  # the thesis's points straight up then, with a derivative of 0
+        angle = lambda p: reference_direction(dataclasses.replace(guidance, flight_path_angle_rad=p), None,  # noqa: E731
+                                              jnp.asarray(-jnp.inf), wind).z  # fmt: skip
+        assert np.isfinite(float(jax.grad(angle)(jnp.asarray(84 * DEG))))
+    assert float(reference_direction(THESIS, None, jnp.asarray(-jnp.inf)).z) == -1.0

@@ -6,6 +6,7 @@ import hashlib
 import json
 from collections.abc import Sequence
 from datetime import datetime
+from typing import TYPE_CHECKING
 from importlib import resources
 from pathlib import Path
 
@@ -18,6 +19,9 @@ from ..env.wind import read_wind_profile
 from ..files import replacing
 from ..ellipse import Ellipse, confidence_ellipse
 from .results import Run
+
+if TYPE_CHECKING:  # the tuning imports optax: only where a tuning is drawn
+    from ..campaign.tuning import Tuning
 
 _ELLIPSE_COLORS = ("tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown")
 _FAILED_MARKERS = ("x", "+", "1", "s", "D")
@@ -401,3 +405,26 @@ def plot_aero_curves(curves: list[dict], title: str, path: str | Path | None = N
     if path is not None:
         save_figure(fig, path)
     return fig
+
+
+def plot_tuning(tuning: Tuning, held_out: dict[str, dict], path: str | Path) -> Path:
+    """``rocketmc tune``'s figure: the training objective against the step, the held-out values (``held_out``: label ->
+    ``campaign.tuning.evaluate``'s) as lines, and each tuned number relative to its start, to ``path``."""
+    from ..campaign.tuning import OBJECTIVES
+
+    figure = Figure(figsize=(9, 4.2), layout="constrained")
+    left, right = figure.subplots(1, 2)
+    steps = np.arange(len(tuning.objective))
+    left.plot(steps, tuning.objective, "o-", color="k", ms=3, label=f"training ({tuning.train} flights)")
+    for (label, result), color in zip(held_out.items(), ("tab:gray", "tab:blue", "tab:green")):
+        left.axhline(result["value"], color=color, ls="--", label=f"held out: {label}")
+    left.set(xlabel="Adam step", ylabel=OBJECTIVES[tuning.objective_name], title=tuning.objective_name)
+    left.legend(fontsize=8)
+    start = np.where(tuning.values[0] != 0.0, tuning.values[0], 1.0)
+    for k, name in enumerate(tuning.paths):
+        right.plot(steps, tuning.values[:, k] / start[k], label=name.removeprefix("gnc.guidance."))
+    right.axvline(tuning.best, color="k", lw=0.8, ls=":")
+    right.set(xlabel="Adam step", ylabel="value / starting value (a start of 0: the value)", title="tuned numbers")
+    right.legend(fontsize=8)
+    save_figure(figure, path)
+    return Path(path)

@@ -19,10 +19,10 @@ import numpy as np
 
 from ..math import safe_sqrt
 from ..sim.flight import max_blocks, simulate_bounded, simulate_one
-from ..sim.params import SimSettings
+from ..sim.params import FlightParams, SimSettings
 from .errors import ConfigError
 from .limits import fixed_reason
-from .model import flight_params
+from .model import GUIDANCE_NUMBERS, flight_params, with_guidance
 from .record import Campaign
 from .sampling import realization_key, sample_dispersions, sample_faults
 
@@ -32,9 +32,20 @@ DIFFERENTIATED_OUTPUTS = ("impact_north_m", "impact_east_m", "apogee_agl_m", "im
 
 def differentiable_inputs(campaign: Campaign) -> list[str]:
     """The paths derivatives can be taken with respect to: every number of ``Campaign.nominal`` the flight reads
-    from its values (``limits.fixed_reason`` None), the dispersed ones first."""
+    from its values (``limits.fixed_reason`` None), the dispersed ones first, then the guidance's numbers
+    (``model.GUIDANCE_NUMBERS``) of a campaign with a closed loop."""
     dispersed = [path for path in campaign.config.dispersions if fixed_reason(path) is None]
-    return dispersed + [path for path in campaign.nominal if path not in dispersed and fixed_reason(path) is None]
+    guidance = [path for path in GUIDANCE_NUMBERS if campaign.config.gnc is not None and path in campaign.nominal]
+    return dispersed + [path for path in campaign.nominal if path not in dispersed and fixed_reason(path) is None] + guidance
+
+
+def _flight_params(campaign: Campaign, values: Mapping, key, wrt: Sequence[str], x) -> FlightParams:
+    """The flight of ``values`` with those of ``wrt`` set to ``x``: guidance numbers in its guidance
+    (``with_guidance``), the others among its values."""
+    given = dict(zip(wrt, x))
+    params = flight_params(campaign, {**values, **given}, key)
+    guidance = {path: value for path, value in given.items() if path in GUIDANCE_NUMBERS}
+    return with_guidance(params, guidance) if guidance else params
 
 
 def default_inputs(campaign: Campaign) -> list[str]:
@@ -87,7 +98,7 @@ def realization_function(campaign: Campaign, settings: SimSettings, master_key, 
     values, key = _values(campaign, master_key, index)
 
     def outputs(x):
-        summary, status = simulate_one(flight_params(campaign, {**values, **dict(zip(wrt, x))}, key), settings)
+        summary, status = simulate_one(_flight_params(campaign, values, key, wrt, x), settings)
         return _outputs(summary), (summary, status)
 
     return jnp.stack([jnp.asarray(values[path], dtype=float) for path in wrt]), outputs
@@ -102,7 +113,7 @@ def batch_function(campaign: Campaign, settings: SimSettings, master_key, indice
 
     def params(flight):  # built inside the vmapped flights: what they share stays one array
         v, key, x = flight
-        return flight_params(campaign, {**v, **dict(zip(wrt, x))}, key)
+        return _flight_params(campaign, v, key, wrt, x)
 
     def outputs(x):
         if reverse:

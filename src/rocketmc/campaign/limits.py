@@ -55,6 +55,9 @@ MAX_CANARD_LIMIT_DEG = 45.0  # canards stall beyond ~20°: 45° is a unit slip, 
 MAX_SERVO_RATE_DEG_S = 10_000.0  # servos slew 60-1000 °/s
 MAX_RATE_DEG_S = 3600.0  # commanded body rates: ten turns a second is no guidance
 MAX_GUIDANCE_GAIN = 1000.0  # guidance [1/s] and integrator [-] gains: 200 × the thesis's; k·T ≫ 1 oscillates
+MAX_WIND_GAIN = 100.0
+"""Guidance's upwind aim [-]: the reference's horizontal speed moved by k_w × the wind; Lynx's is ~19 m/s, so 100
+turns a 1 m/s wind into a reference 80° off its heading: beyond, the aim no longer points where the rocket goes."""
 MAX_SENSOR_VALUE = 1e7  # any sensor's unit (m/s², deg/s, µT, Pa, deg): 1e7 Pa is 100 atmospheres
 MAX_SENSOR_LATENCY_S = 1.0  # a sensor later than a second is a logger, not a GNC input
 MAX_MISALIGNMENT_DEG = 10.0  # a sensor more than 10° off its mount is mounted elsewhere

@@ -273,7 +273,47 @@ def guidance_params(g: GuidanceConfig, reference: GuidanceReference) -> Guidance
         roll_gain=jnp.asarray(g.roll_gain), roll_heading_rad=rad(reference.roll_heading_deg),
         roll_rate_limit_rad_s=rad(g.roll_rate_limit_deg_s), integrator_gain=Vec3(*(jnp.asarray(k) for k in g.integrator_gain)),
         window_start_s=jnp.asarray(g.window_start_s), window_end_s=jnp.asarray(g.window_end_s),
+        wind_gain=None if g.wind_gain is None else jnp.asarray(g.wind_gain),
+        wind_time_constant_s=None if g.wind_gain is None else jnp.asarray(g.wind_time_constant_s),
     )  # fmt: skip
+
+
+DEG = math.pi / 180.0  # [rad/deg]
+GUIDANCE_NUMBERS = {
+    "gnc.guidance.apogee_m": ("apogee_m", 1.0),
+    "gnc.guidance.t0_s": ("t0_s", 1.0),
+    "gnc.guidance.flight_path_angle_deg": ("flight_path_angle_rad", DEG),
+    "gnc.guidance.heading_deg": ("heading_rad", DEG),
+    "gnc.guidance.gain": ("gain", 1.0),
+    "gnc.guidance.rate_limit_deg_s": ("rate_limit_rad_s", DEG),
+    "gnc.guidance.roll_gain": ("roll_gain", 1.0),
+    "gnc.guidance.roll_rate_limit_deg_s": ("roll_rate_limit_rad_s", DEG),
+    "gnc.guidance.integrator_gain.0": ("integrator_gain.x", 1.0),
+    "gnc.guidance.integrator_gain.1": ("integrator_gain.y", 1.0),
+    "gnc.guidance.integrator_gain.2": ("integrator_gain.z", 1.0),
+    "gnc.guidance.wind_gain": ("wind_gain", 1.0),
+    "gnc.guidance.wind_time_constant_s": ("wind_time_constant_s", 1.0),
+}
+"""[gnc.guidance]'s continuous numbers a flight can take as values (``with_guidance``): path -> (the
+``GuidanceParams`` field, a Vec3's component after a dot; the factor from the config's unit to SI)."""
+
+
+def with_guidance(params: FlightParams, values: Mapping) -> FlightParams:
+    """``params`` with the guidance numbers of ``values`` (``GUIDANCE_NUMBERS``' paths -> values in the config's
+    units, traced or not) in place of the campaign's: what ``rocketmc tune`` adjusts and ``sensitivities --wrt``
+    differentiates. The campaign's own flights read them as constants (``guidance_params``)."""
+    changes: dict = {}
+    for path, value in values.items():
+        field, factor = GUIDANCE_NUMBERS[path]
+        name, _, component = field.partition(".")
+        scaled = value * factor
+        if component:
+            vector = changes.get(name, getattr(params.gnc.guidance, name))
+            changes[name] = vector._replace(**{component: scaled})
+        else:
+            changes[name] = scaled
+    guidance = dataclasses.replace(params.gnc.guidance, **changes)
+    return dataclasses.replace(params, gnc=dataclasses.replace(params.gnc, guidance=guidance))
 
 
 def nominal_rail(campaign: Campaign) -> tuple[Quat, Vec3]:

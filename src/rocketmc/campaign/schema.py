@@ -32,6 +32,7 @@ from .limits import (
     MAX_FLIGHT_TIME_S,
     MAX_GATE,
     MAX_GUIDANCE_GAIN,
+    MAX_WIND_GAIN,
     MAX_INERTIA_KGM2,
     MAX_ISP_S,
     MAX_LENGTH_KM,
@@ -677,6 +678,13 @@ class GuidanceConfig(_Strict):
     )
     window_start_s: float = Field(1.0, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
     window_end_s: float = Field(10.0, ge=0, le=MAX_FLIGHT_TIME_S, description="[s since liftoff]")
+    wind_gain: float | None = Field(
+        None, ge=0, le=MAX_WIND_GAIN,
+        description="k_w: the reference aimed upwind by k_w times the wind the attitude reveals (none: not aimed, the thesis's)",
+    )
+    wind_time_constant_s: float = Field(
+        2.0, gt=0, le=MAX_FLIGHT_TIME_S, description="the low-pass on the upwind aim's wind (with wind_gain) [s]"
+    )
 
     @field_validator("window_end_s")
     @classmethod

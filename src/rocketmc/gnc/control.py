@@ -31,7 +31,7 @@ from .navigation import (
     DeadReckoning, FilterParams, FilterState, NavigationMode, bus_measurements, dead_reckoning, filter_step,
     initial_dead_reckoning, initial_filters, liftoff_sensed, navigation_summary, track_errors,
 )  # fmt: skip
-from .guidance import GuidanceParams, Navigation, guidance_active, integrate_errors, rate_command
+from .guidance import GuidanceParams, Navigation, filtered_wind, guidance_active, integrate_errors, rate_command
 
 GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
 """Outputs of the gain table: K (3, 11) row by row; rows (yaw, pitch, roll), columns docs/gnc.md §5's state
@@ -67,7 +67,8 @@ class GncState:
     time; saturated_time [s] active with a fin saturated; max_deflection, the largest |δ| of any fin at a
     period start [rad]. navigation: the navigation's state (``gnc.navigation``: ``DeadReckoning`` with SENSORS,
     ``FilterState`` with FILTERS, None with TRUTH); recovery: the parachutes' triggers from that navigation
-    (``Recovery``; None with TRUTH)."""
+    (``Recovery``; None with TRUTH); wind_n: the upwind aim's wind [m/s, NED] (``guidance.filtered_wind``; None
+    without the aim)."""
 
     servo: ServoState
     integrators: Vec3
@@ -81,6 +82,7 @@ class GncState:
     max_deflection: jnp.ndarray
     navigation: DeadReckoning | FilterState | None = None
     recovery: Recovery | None = None
+    wind_n: Vec3 | None = None
 
 
 APOGEE_DESCENDING_TICKS = 5
@@ -130,10 +132,11 @@ def initial_gnc(params: GncParams, like) -> GncState:
                   NavigationMode.FILTERS: lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
     recovery = (None if params.navigation is NavigationMode.TRUTH
                 else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf, zero))  # fmt: skip
+    wind_n = None if params.guidance.wind_gain is None else Vec3(zero, zero, zero)
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),
-        zero, zero, zero, zero, zero, navigation, recovery,
+        zero, zero, zero, zero, zero, navigation, recovery, wind_n,
     )  # fmt: skip
 
 
@@ -178,7 +181,9 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
     liftoff_time = jnp.where(jnp.isinf(state.liftoff_time) & moving, t, state.liftoff_time)
     since_liftoff = t - liftoff_time  # −inf before liftoff: outside any window
     active = guidance_active(params.guidance, since_liftoff) & ~jnp.asarray(canopy)  # canopy: False without parachutes
-    rates_cmd, chi = rate_command(params.guidance, nav, since_liftoff)
+    g = params.guidance
+    wind_n = None if state.wind_n is None else filtered_wind(state.wind_n, nav, dt, g.wind_time_constant_s)
+    rates_cmd, chi = rate_command(g, nav, since_liftoff, wind_n)
     v_b = nav.q_nb.rotate_inverse(nav.v_n)
     k = gains_at(params.gains, v_b.x, altitude_msl)
     errors = integrate_errors(state.integrators, rates_cmd, nav.omega_b, dt, active, params.guidance.integrator_gain)
@@ -210,6 +215,7 @@ def gnc_step(params: GncParams, state: GncState, nav: Navigation, moving, t, dt,
         functools.reduce(jnp.maximum, [jnp.abs(d) for d in deflections], state.max_deflection),
         state.navigation,
         state.recovery,
+        wind_n,
     )
 
 

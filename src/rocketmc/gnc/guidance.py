@@ -10,6 +10,7 @@ motion on the rail): the reference and the window share that clock.
 from __future__ import annotations
 
 
+import jax
 import jax.numpy as jnp
 
 from ..env.atmosphere import G0
@@ -42,7 +43,9 @@ class GuidanceParams:
     pitch and yaw rate command [rad/s]; min_speed_mps: below this inertial speed [m/s] the pitch and yaw command
     is zero. Roll: roll_gain [1/s], roll_heading_rad the azimuth [rad] the body z axis is steered toward,
     roll_rate_limit_rad_s [rad/s]. integrator_gain: k_int of e_p, e_q, e_r [-]. window_start_s, window_end_s:
-    guidance acts for window_start_s ≤ t < window_end_s [s since liftoff].
+    guidance acts for window_start_s ≤ t < window_end_s [s since liftoff]. wind_gain: k_w [-] of the upwind aim
+    (``reference_direction``), wind_time_constant_s: τ [s] of the low-pass on its wind (``filtered_wind``); None:
+    no upwind aim (the thesis's reference, nothing computed).
     """
 
     apogee_m: jnp.ndarray
@@ -58,6 +61,38 @@ class GuidanceParams:
     integrator_gain: Vec3
     window_start_s: jnp.ndarray
     window_end_s: jnp.ndarray
+    wind_gain: jnp.ndarray | None = None
+    wind_time_constant_s: jnp.ndarray | None = None
+
+
+MIN_WIND_AXIS_CLIMB = 0.5
+"""The wind is estimated from the attitude (``wind_estimate``) only while the body axis climbs at least this steeply
+(its down component ≤ −0.5: 30° above the horizon); below, the estimate divides by a vanishing climb and is 0."""
+
+
+def wind_estimate(nav: Navigation) -> Vec3:
+    """The horizontal wind [m/s, NED] the rocket's weathercocking reveals: a statically stable airframe flies close to
+    zero angle of attack, its air velocity v − w along its axis x_b; with no vertical wind, v − w = s x_b with
+    s = v_d / x_b,d, hence w = v − s x_b (down component 0). Exact at zero angle of attack; an angle of attack α
+    (a gust, a manoeuvre) adds ~‖v‖·α."""
+    axis_n = nav.q_nb.rotate(Vec3(jnp.ones_like(nav.v_n.x), jnp.zeros_like(nav.v_n.x), jnp.zeros_like(nav.v_n.x)))
+    climbing = axis_n.z <= -MIN_WIND_AXIS_CLIMB
+    along = nav.v_n.z / jnp.where(climbing, axis_n.z, -1.0)
+    zero = jnp.zeros_like(nav.v_n.x)
+    return Vec3(jnp.where(climbing, nav.v_n.x - along * axis_n.x, zero),
+                jnp.where(climbing, nav.v_n.y - along * axis_n.y, zero), zero)  # fmt: skip
+
+
+def filtered_wind(previous: Vec3, nav: Navigation, dt, time_constant_s) -> Vec3:
+    """The upwind aim's wind [m/s, NED]: ``wind_estimate`` through a first-order low-pass of time constant τ [s],
+    one GNC period dt [s] on (exact for an estimate held over the period: w += (1 − e^(−dt/τ)) (ŵ − w)). The
+    estimate also reads the angle of attack of the rocket's own manoeuvres, which the aim would feed back (measured
+    on lynx_nominal_ctrl_1s: aimed on the raw estimate, the canards saturated 50-70 % of the window, and the landing
+    point jumped by ~100 m for a change of 0.05 in k_w); the turn lasts a fraction of a second, the wind it crosses
+    changes over seconds."""
+    blend = 1.0 - jnp.exp(-dt / time_constant_s)
+    raw = wind_estimate(nav)
+    return Vec3(previous.x + blend * (raw.x - previous.x), previous.y + blend * (raw.y - previous.y), previous.z)
 
 
 def guidance_active(params: GuidanceParams, t) -> jnp.ndarray:
@@ -65,20 +100,46 @@ def guidance_active(params: GuidanceParams, t) -> jnp.ndarray:
     return (t >= params.window_start_s) & (t < params.window_end_s)
 
 
-def reference_direction(params: GuidanceParams, nav: Navigation, t) -> Vec3:
+@jax.custom_jvp
+def _climb_angle(climb, v_x):
+    """γ = arctan(climb / v_x) [rad] of a climb and a horizontal speed v_x > 0 [m/s]. Its derivative is 0 at an
+    infinite climb (the reference before liftoff, t = −inf), where the textbook one is inf·0: reverse mode would carry
+    NaN into every derivative of the reference's numbers. The forward value is numpy's, bit for bit."""
+    return jnp.arctan(climb / v_x)
+
+
+@_climb_angle.defjvp
+def _climb_angle_jvp(primals, tangents):
+    (climb, v_x), (d_climb, d_v_x) = primals, tangents
+    finite = jnp.isfinite(climb)
+    c = jnp.where(finite, climb, 0.0)
+    slope = (v_x * d_climb - c * d_v_x) / (v_x * v_x + c * c)
+    return jnp.arctan(climb / v_x), jnp.where(finite, slope, 0.0)
+
+
+def reference_direction(params: GuidanceParams, nav: Navigation, t, wind_n: Vec3 | None = None) -> Vec3:
     """Desired velocity direction d_ref (unit, NED) of the parabolic reference at t [s since liftoff].
 
     docs/gnc.md §4: c1 = √(2 g0 H), v_x = c1/tan γ0, γ_ref = atan((c1 − g0 (t − t0))/v_x),
     d_ref = (cos ψ cos γ_ref, sin ψ cos γ_ref, −sin γ_ref): a point mass climbing at c1 at t0 with horizontal
-    speed v_x along ψ, which rises H after t0. The thesis's reference depends on time only, so ``nav`` is not
-    read; it is in the signature so that a reference of the position can replace this one.
+    speed v_x along ψ, which rises H after t0. The thesis's reference depends on time only (``nav`` is not read; it
+    is in the signature so that a reference of the position can replace this one). With ``wind_gain`` k_w set, the
+    reference's horizontal velocity v_x (cos ψ, sin ψ) is aimed upwind by k_w times ``wind_n``, the wind the
+    navigation reveals (``filtered_wind``), d_ref the direction of
+    (v_x cos ψ − k_w w_n, v_x sin ψ − k_w w_e, −(c1 − g0 (t − t0))): a rocket that climbs into the wind lands closer
+    to where the same rocket lands in calm air after drifting downwind under its canopies. Before liftoff (t = −inf)
+    the thesis's reference points straight up (``_climb_angle``), the aimed one is its direction at liftoff, t = 0.
     """
-    del nav
     c1 = jnp.sqrt(2.0 * G0 * params.apogee_m)
     v_x = c1 / jnp.tan(params.flight_path_angle_rad)
-    gamma = jnp.arctan((c1 - G0 * (t - params.t0_s)) / v_x)
-    cg = jnp.cos(gamma)
-    return Vec3(jnp.cos(params.heading_rad) * cg, jnp.sin(params.heading_rad) * cg, -jnp.sin(gamma))
+    if params.wind_gain is None:
+        gamma = _climb_angle(c1 - G0 * (t - params.t0_s), v_x)
+        cg = jnp.cos(gamma)
+        return Vec3(jnp.cos(params.heading_rad) * cg, jnp.sin(params.heading_rad) * cg, -jnp.sin(gamma))
+    climb = c1 - G0 * (jnp.where(jnp.isfinite(t), t, 0.0) - params.t0_s)
+    aim = Vec3(v_x * jnp.cos(params.heading_rad) - params.wind_gain * wind_n.x,
+               v_x * jnp.sin(params.heading_rad) - params.wind_gain * wind_n.y, -climb)  # fmt: skip
+    return aim * (1.0 / aim.norm())
 
 
 def _clip_norm2(y, z, limit):
@@ -88,7 +149,7 @@ def _clip_norm2(y, z, limit):
     return y * scale, z * scale
 
 
-def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.ndarray]:
+def rate_command(params: GuidanceParams, nav: Navigation, t, wind_n: Vec3 | None = None) -> tuple[Vec3, jnp.ndarray]:
     """Body-rate command ω_cmd = (p, q, r), FRD [rad/s], and the tracking error χ [rad] at t [s since liftoff].
 
     docs/gnc.md §4, V = nav.v_n: χ = ∠(V, d_ref) ∈ [0, π], computed as atan2(‖V×d‖, V·d) (the thesis's
@@ -98,10 +159,10 @@ def rate_command(params: GuidanceParams, nav: Navigation, t) -> tuple[Vec3, jnp.
     dropped). Roll: t_b = A(q) (cos ψ_roll, sin ψ_roll, 0), the roll error φ_e = atan2(−t_b,y, t_b,z) ∈ (−π, π] is the
     rotation about +x_b that takes the body z axis onto t_b's lateral (y, z) part (positive p turns z_b toward
     −y_b); p = clip(roll_gain φ_e, ±roll_rate_limit_rad_s). All three are zero outside the window; χ is returned
-    at every t (the reference is defined at every t).
+    at every t (the reference is defined at every t). wind_n: the upwind aim's wind (``reference_direction``).
     """
     v = nav.v_n
-    d = reference_direction(params, nav, t)
+    d = reference_direction(params, nav, t, wind_n)
     cross = v.cross(d)
     sin_part = cross.norm()
     chi = safe_arctan2(sin_part, v.dot(d))
