@@ -114,3 +114,15 @@ def test_impact_difference(tmp_path):
     assert c["impact_difference_m"]["max"] == pytest.approx(d.max(), rel=1e-9)
     assert c["impact_difference_m"]["median"] == pytest.approx(np.median(d), rel=1e-9)
     assert c["ellipse95_area_m2"]["relative_difference"] == pytest.approx(1.01**2 - 1, rel=1e-9)
+
+
+def test_gradient_cost_times_the_ellipse_area_forward(monkeypatch):
+    """The bench's forward pass of the ellipse's area (the reverse pass shares its function; its compilation, ~2 min,
+    is left to `rocketmc bench`): it compiles, runs and reports in the report's fields."""
+    from rocketmc import bench
+    from rocketmc.campaign import load_campaign
+
+    monkeypatch.setattr(bench, "GRADIENT_FLIGHTS", 4)
+    result = bench.gradient_cost(load_campaign(CAMPAIGN.parent / "lynx_ballistic.toml"), "forward", repeats=1)
+    assert result["mode"] == "forward" and result["flights"] == 4 and result["params"] == list(bench.GRADIENT_PARAMS)
+    assert result["compile_s"] > 0.0 and result["run_s"] > 0.0
