@@ -208,12 +208,14 @@ def test_help_matches_the_readme(capsys):
     documented = _readme_commands()
     assert set(documented) == {("run",), ("report",), ("compare",), ("aero", "derivatives"), ("gnc", "design"),
                                ("sensors", "simulate"), ("navigate",), ("fly",), ("validate",), ("bench",),
-                               ("budget",), ("motors",), ("import",), ("sensitivities",), ("tune",)}  # fmt: skip
+                               ("budget",), ("motors",), ("import",), ("sensitivities",), ("tune",),
+                               ("airbrakes", "design")}  # fmt: skip
     listed = re.search(r"\{([a-z,]+)\}", _help(capsys)).group(1).split(",")
     assert sorted(listed) == sorted(words[0] for words in documented)
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "aero")).group(1).split(",") == ["derivatives"]
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "gnc")).group(1).split(",") == ["design"]
     assert re.search(r"\{([a-z,]+)\}", _help(capsys, "sensors")).group(1).split(",") == ["simulate"]
+    assert re.search(r"\{([a-z,]+)\}", _help(capsys, "airbrakes")).group(1).split(",") == ["design"]
     for words, (options, choices) in documented.items():
         text = _help(capsys, *words)
         assert text.startswith(f"usage: rocketmc {' '.join(words)} "), text

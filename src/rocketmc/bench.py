@@ -111,6 +111,11 @@ def ratios(campaign, repeats: int = 3) -> dict:
     return {"loop_flights": LOOP_FLIGHTS, "batch": batch, "s_per_flight": s, "loop_over_batch": s["loop"] / s["batch"]}
 
 
+BENCH_AIRBRAKES = {"target_apogee_m": 1000.0, "panels": {"count": 3, "width_m": 0.05, "max_extension_m": 0.02}}
+"""The air brakes ``costs`` adds to a campaign without its own (truth navigation; their cost per period does not
+depend on their numbers: the prediction runs at every GNC tick)."""
+
+
 def costs(campaign, repeats: int = 3) -> dict:
     """The cost ratios of docs/performance.md on ``campaign``, per flight of vmapped batches (``_batch``), timed
     together: the interpolated aerodynamics against the simplified (controller off), the closed loop (the
@@ -121,11 +126,17 @@ def costs(campaign, repeats: int = 3) -> dict:
     controller's period (``open_loop_dt_s`` unset), so that they measure what the controller, the sensors and the
     filters cost a period; "campaign_step" is the open loop at the campaign's own ``open_loop_dt_s`` (longer
     periods where the campaign sets them) and ``full_gnc_speed_over_campaign_step`` the full GNC against it.
+    "airbrakes": the open loop with the campaign's [airbrakes] (``BENCH_AIRBRAKES`` if it has none) on the true state,
+    which flies every period on the GNC grid, against the open loop without them (``airbrakes_over_open_loop``).
     Run on one core with one XLA thread (``measure(..., kind="costs")``): a cost is the
     work a flight takes, and on one thread the best rounds of a function agree within ~5 % where the
     two-core rounds, whose threads wait on each other, spread ~10 % (measured on the 2-core VM)."""
-    campaign_step = with_overrides(campaign, aero_model="simplified", controller=False, sensors=False)
+    own_brakes = campaign.config.airbrakes is not None
+    bare = with_overrides(campaign, aero_model="simplified", controller=False, sensors=False)
+    campaign_step = with_overrides(bare, airbrakes=False) if own_brakes else bare
     open_loop = with_overrides(campaign_step, values={"simulation.open_loop_dt_s": None})
+    braked = with_overrides(bare, values={"simulation.open_loop_dt_s": None,
+                                          **({} if own_brakes else {"airbrakes": BENCH_AIRBRAKES})})  # fmt: skip
     closed_loop = with_overrides(open_loop, controller=True)
     batch = _batch()
     s = _timed_together(campaign, {
@@ -135,12 +146,14 @@ def costs(campaign, repeats: int = 3) -> dict:
         "closed_loop": (compile_chunk, (closed_loop, batch), batch),
         "sensors": (compile_chunk, (with_overrides(closed_loop, sensors=True), batch), batch),
         "filters": (compile_chunk, (with_overrides(closed_loop, navigation="filters"), batch), batch),
+        "airbrakes": (compile_chunk, (braked, batch), batch),
     }, repeats)  # fmt: skip
     return {"batch": batch, "s_per_flight": s, "interpolated_over_simplified": s["interpolated"] / s["simplified"],
             "closed_over_open_loop": s["closed_loop"] / s["simplified"],
             "sensors_over_closed_loop": s["sensors"] / s["closed_loop"],
             "full_gnc_speed_over_open_loop": s["simplified"] / s["filters"],
-            "full_gnc_speed_over_campaign_step": s["campaign_step"] / s["filters"]}  # fmt: skip
+            "full_gnc_speed_over_campaign_step": s["campaign_step"] / s["filters"],
+            "airbrakes_over_open_loop": s["airbrakes"] / s["simplified"]}  # fmt: skip
 
 
 GRADIENT_FLIGHTS = 1000
@@ -405,7 +418,8 @@ def run_benchmarks(
         f"closed loop {1 / c['closed_over_open_loop']:.2f}x the open loop's flights/s, sensors "
         f"{c['sensors_over_closed_loop']:.2f}x the closed loop's cost, the full GNC (filters) "
         f"{c['full_gnc_speed_over_open_loop']:.2f}x the open loop's flights/s on one grid, "
-        f"{c['full_gnc_speed_over_campaign_step']:.2f}x at the campaign's open-loop period")  # fmt: skip
+        f"{c['full_gnc_speed_over_campaign_step']:.2f}x at the campaign's open-loop period, air brakes "
+        f"{c['airbrakes_over_open_loop']:.2f}x the open loop's cost")  # fmt: skip
     forward, gradient = (measure(kind, path, precisions[0], repeats=2) for kind in ("forward_pass", "gradient"))
     report["gradient"] = {"forward": forward, "reverse": gradient}
     log(f"gradient of the ellipse's area over {gradient['flights']} flights ({precisions[0]}): "
@@ -479,7 +493,8 @@ def format_report(report: dict) -> str:
         f"the full GNC (thesis sensors, MEKF and Kalman filter) {c['full_gnc_speed_over_open_loop']:.2f}x the "
         f"flights/s of the controller off ({1e3 * s['filters']:.2f} ms), "
         f"{c['full_gnc_speed_over_campaign_step']:.2f}x those flown at the campaign's open-loop period "
-        f"({1e3 * s['campaign_step']:.2f} ms)"
+        f"({1e3 * s['campaign_step']:.2f} ms); air brakes flown to a target on the true state "
+        f"{c['airbrakes_over_open_loop']:.2f}x the open loop's cost ({1e3 * s['airbrakes']:.2f} ms)"
     )
     forward, gradient = report["gradient"]["forward"], report["gradient"]["reverse"]
     lines.append(

@@ -356,6 +356,17 @@ def _gnc_design(args) -> int:
     return 0
 
 
+def _airbrakes_design(args) -> int:
+    from .campaign.airbrakes import format_design
+
+    campaign = _campaign(args.campaign)
+    if campaign.airbrake_design is None:
+        raise RocketmcError(f"{args.campaign}: no [airbrakes] section, so no air brakes to design")
+    design = campaign.airbrake_design
+    print(json.dumps(design._asdict(), indent=2) if args.json else format_design(design))
+    return 0
+
+
 def _sensors_simulate(args) -> int:
     from .analysis.sensor_log import LOG_FILES, write_sensor_log
     from .campaign.sensor_record import sensor_record
@@ -604,12 +615,14 @@ def _flight_switches(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sensors", choices=("on", "off"),
                         help="on: the controller flies on raw sensors (the campaign's [avionics], or the thesis's "
                              "parts); off: no sensors, the controller on perfect navigation")  # fmt: skip
+    parser.add_argument("--airbrakes", choices=("off",), help="off: the same flights without the campaign's [airbrakes]")
 
 
 def _switched(args) -> dict:
     """The campaign overrides of ``_flight_switches``' options (None: the campaign's own)."""
     on = lambda switch: None if switch is None else switch == "on"  # noqa: E731
-    return {"aero_model": args.aero_model, "controller": on(args.controller), "sensors": on(args.sensors)}
+    return {"aero_model": args.aero_model, "controller": on(args.controller), "sensors": on(args.sensors),
+            "airbrakes": on(args.airbrakes)}  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -735,6 +748,12 @@ def build_parser() -> argparse.ArgumentParser:
     design.add_argument("--plot", help="write the main gains and spectral radius against speed to this PNG")
     design.add_argument("--aero-model", choices=("interpolated", "simplified", "linear"),
                         help="aerodynamic model (overrides rocket.aero.model)")  # fmt: skip
+    airbrakes = commands.add_parser("airbrakes", help="the air brakes of a campaign")
+    airbrakes_commands = airbrakes.add_subparsers(dest="airbrakes_command", required=True, parser_class=_Parser)
+    brake_design = airbrakes_commands.add_parser(
+        "design", help="the air brakes' gain designed at set-up: the nominal flight where they may open, their authority")
+    brake_design.add_argument("campaign", help="campaign file (TOML) with an [airbrakes] section")
+    brake_design.add_argument("--json", action="store_true", help="print as JSON")
     sensors = commands.add_parser("sensors", help="the simulated sensors of a campaign")
     sensors_commands = sensors.add_subparsers(dest="sensors_command", required=True, parser_class=_Parser)
     simulate = sensors_commands.add_parser(
@@ -887,6 +906,7 @@ def main(argv: list[str] | None = None) -> int:
     if len(getattr(args, "files", [])) == 1:
         parser.error("compare needs at least two result files")
     command = {"run": _run, "report": _report, "compare": _compare, "aero": _aero_derivatives, "gnc": _gnc_design,
+               "airbrakes": _airbrakes_design,
                "sensors": _sensors_simulate, "navigate": _navigate, "fly": _fly_one, "validate": _validate, "bench": _bench, "budget": _budget,
                "motors": _motors, "import": _import,
                "sensitivities": _sensitivities, "tune": _tune}  # fmt: skip

@@ -15,7 +15,7 @@ import numpy as np
 from ..campaign.schema import FAULT_SECTIONS
 from ..errors import RocketmcError
 from ..ellipse import MIN_BOOTSTRAP_POINTS, bootstrap_intervals, confidence_ellipse, ellipse_area_m2, percentile_interval
-from .results import Run, text_table, navigation_warnings
+from .results import Run, apogee_about, apogee_target_m, format_apogee_about, navigation_warnings, text_table
 
 LEVEL = 0.95
 """Confidence level of the compared ellipses (the one ``report`` gives bootstrap intervals for)."""
@@ -138,7 +138,12 @@ def compare(runs: Sequence[tuple[str, Run]], level: float = LEVEL) -> dict:
     to the first, and each run's ``navigation_warnings`` prefixed with its file name: ``{"level", "runs":
     [{"file", ...}], "ratios": [{"file", "baseline", ...}], "warnings"}``."""
     (base_file, baseline), others = runs[0], runs[1:]
+    target = next((t for _, run in runs if (t := apogee_target_m(run)) is not None), None)
     return {
+        "apogee_target": None if target is None else [{"file": file, **(apogee_about(run, target) or {})} for file, run in runs],
+        "apogee_rms_ratios": None if target is None else [
+            {"file": file, "baseline": base_file, **apogee_rms_ratio(baseline, run, target, (base_file, file))}
+            for file, run in others],  # fmt: skip
         "level": level,
         "warnings": [f"{file}: {line}" for file, run in runs for line in navigation_warnings(run)],
         "runs": [{"file": file, **_naming(file, dispersion, run, level)} for file, run in runs],
@@ -146,6 +151,23 @@ def compare(runs: Sequence[tuple[str, Run]], level: float = LEVEL) -> dict:
                     **_naming(f"{file} against {base_file}", area_ratio, baseline, run, level, (base_file, file))}
                    for file, run in others],  # fmt: skip
     }
+
+
+def apogee_rms_ratio(baseline: Run, other: Run, target_m: float, names: tuple[str, str]) -> dict:
+    """Ratio of ``other``'s RMS apogee error to ``target_m`` [m] to ``baseline``'s, with its percentile-bootstrap
+    interval: paired as ``area_ratio`` (the flights ok in both), else each run's ok flights."""
+    reason = unpaired_reason(baseline, other, names)
+    paired = reason is None
+    kept = baseline.ok & other.ok if paired else None
+    errors = [run.outputs["apogee_agl_m"].to_numpy(dtype=float)[run.ok if kept is None else kept] - target_m
+              for run in (baseline, other)]  # fmt: skip
+    errors = [e[np.isfinite(e)] for e in errors] if not paired else errors
+    _enough(min(e.size for e in errors), "flight(s) with an apogee")
+
+    def ratio(base, run, axis=-1):
+        return np.sqrt(np.mean(run**2, axis=axis) / np.mean(base**2, axis=axis))
+
+    return {"paired": paired, "ratio": float(ratio(*errors)), "interval": list(percentile_interval(errors, ratio, paired))}
 
 
 def _naming(what: str, function, *args):
@@ -196,5 +218,10 @@ def format_comparison(comparison: dict) -> str:
         )
         out += [f"{r['file']}: unpaired, {r['unpaired_reason']}: the runs resampled independently"
                 for r in comparison["ratios"] if not r["paired"]]  # fmt: skip
+    if comparison["apogee_target"]:
+        out += ["", "Apogee against the air brakes' target (ok realizations)"]
+        out += [f"  {r['file']}: {format_apogee_about(r)}" for r in comparison["apogee_target"] if "n" in r]
+        out += [f"  {r['file']}: RMS error {r['ratio']:.4g}x the baseline's ({_interval(r['interval'])}, "
+                f"{'paired' if r['paired'] else 'unpaired'})" for r in comparison["apogee_rms_ratios"]]  # fmt: skip
     out += [f"Warning: {line}" for line in comparison["warnings"]]
     return "\n".join(out)

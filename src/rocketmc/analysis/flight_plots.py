@@ -1,5 +1,6 @@
 """Figures of one flight's time series (``rocketmc fly --plot DIR``): the 3-D path, altitude and speed, the angles
-of attack and the static margin against time, each sample a period start of the flight's own periods."""
+of attack and the static margin against time, and with air brakes their deployment and predicted apogee
+(``AIRBRAKE_FIGURE``), each sample a period start of the flight's own periods."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from .flight_record import ascent, events
 from .plots import save_figure
 
 FIGURES = ("path_3d.png", "altitude_speed.png", "angles_of_attack.png", "stability_margin.png")
+AIRBRAKE_FIGURE = "airbrakes.png"
 _EVENT_COLORS = {"rail exit": "tab:gray", "burnout": "tab:red", "apogee": "tab:green", "impact": "black"}
 _CHUTE_COLORS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive")
 
@@ -42,7 +44,8 @@ def _finish(axes, record: FlightRecord, until: float | None = None, loc: str = "
 
 
 def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
-    """Write the ``FIGURES`` of ``record`` in ``directory`` (created if need be); returns their paths."""
+    """Write the ``FIGURES`` of ``record`` (and ``AIRBRAKE_FIGURE`` with air brakes) in ``directory`` (created if need
+    be); returns their paths."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     paths = [directory / name for name in FIGURES]
@@ -117,4 +120,26 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
     _finish((ax_margin, ax_position), record, end, loc="lower right")
     ax_margin.set_title(f"{record.label}: static stability, rail exit to apogee")
     _save(fig, paths[3])
+    if "airbrake_deployment" in s:
+        paths.append(_plot_airbrakes(record, directory / AIRBRAKE_FIGURE))
     return paths
+
+
+def _plot_airbrakes(record: FlightRecord, path: Path) -> Path:
+    """The air brakes to apogee: altitude, the software's predicted apogee and the target; deployment and command."""
+    up, end = ascent(record), record.summary["apogee_time_s"]
+    target = record.campaign.config.airbrakes.target_apogee_m
+    fig = Figure(figsize=(9.0, 7.5))
+    ax_height, ax_deployment = fig.subplots(2, 1, sharex=True)
+    ax_height.plot(up["time"], up["altitude"], color="tab:blue", label="altitude above the pad")
+    ax_height.plot(up["time"], up["predicted_apogee"], color="tab:orange", label="predicted apogee (while allowed)")
+    ax_height.axhline(target, color="black", linewidth=0.8, label=f"target {target:.0f} m")
+    ax_height.set_ylabel("height above the pad [m]")
+    ax_deployment.plot(up["time"], up["airbrake_deployment"], color="tab:blue", label="deployment")
+    ax_deployment.plot(up["time"], up["airbrake_command"], color="tab:orange", linewidth=0.8, label="command")
+    ax_deployment.set_ylabel("deployment [0 … 1]")
+    ax_deployment.set_xlabel("time since the start on the rail [s]")
+    _finish((ax_height, ax_deployment), record, end, loc="lower right")
+    ax_height.set_title(f"{record.label}: air brakes, rail exit to apogee")
+    _save(fig, path)
+    return path

@@ -245,6 +245,44 @@ def fault_rows(run: Run) -> list[dict]:
     return rows
 
 
+APOGEE_ERROR = "apogee_error_m"
+"""The output of a run with air brakes: the apogee above the pad less their target."""
+
+
+def apogee_target_m(run: Run) -> float | None:
+    """The air brakes' target apogee above the pad [m] of ``run`` (apogee less ``APOGEE_ERROR``), None without."""
+    if APOGEE_ERROR not in run.outputs:
+        return None
+    target = (run.outputs["apogee_agl_m"] - run.outputs[APOGEE_ERROR]).to_numpy(dtype=float)
+    target = target[np.isfinite(target)]
+    return float(np.median(target)) if target.size else None
+
+
+def apogee_about(run: Run, target_m: float) -> dict | None:
+    """The ok flights' apogee above the pad against ``target_m`` [m]: n, mean_error_m, rms_error_m, the error's
+    central 95 % interval (2.5th to 97.5th percentile) ``interval_95_m``, and the fractions of flights within 1 % and
+    5 % of the target; None without apogees."""
+    error = run.outputs["apogee_agl_m"].to_numpy(dtype=float)[run.ok] - target_m
+    error = error[np.isfinite(error)]
+    if error.size == 0:
+        return None
+    return {
+        "target_m": target_m, "n": int(error.size), "mean_error_m": float(error.mean()),
+        "rms_error_m": float(np.sqrt(np.mean(error**2))),
+        "interval_95_m": [float(x) for x in np.percentile(error, [2.5, 97.5])],
+        "within_1_percent": float(np.mean(np.abs(error) <= 0.01 * target_m)),
+        "within_5_percent": float(np.mean(np.abs(error) <= 0.05 * target_m)),
+    }  # fmt: skip
+
+
+def format_apogee_about(about: dict) -> str:
+    """One line of ``apogee_about``."""
+    low, high = about["interval_95_m"]
+    return (f"{about['target_m']:.0f} m: mean error {about['mean_error_m']:+.1f} m, RMS {about['rms_error_m']:.1f} m, "
+            f"95 % of flights {low:+.1f}…{high:+.1f} m, within 1 %: {100 * about['within_1_percent']:.1f} %, within 5 %: "
+            f"{100 * about['within_5_percent']:.1f} %")  # fmt: skip
+
+
 def _stat(x: float) -> float | None:
     """Float, with NaN/inf mapped to None (strict JSON has no NaN)."""
     return float(x) if math.isfinite(x) else None
@@ -282,7 +320,7 @@ def summarize(run: Run) -> dict:
     the flights that had it and the 95 % ellipse with and without them; empty without faults) and ``warnings`` (what ``run`` warned of:
     the nominal rocket's static stability, flights beyond the aerodynamic method's validity, the file's
     ``warnings`` attribute; then ``navigation_warnings``) and ``trajectories`` (the realizations whose trajectories
-    the file keeps, ascending).
+    the file keeps, ascending) and ``apogee_target`` (with air brakes, ``apogee_about`` their target; else None).
     """
     ok = run.ok
     status = run.outputs["status"].to_numpy()
@@ -330,6 +368,7 @@ def summarize(run: Run) -> dict:
         "faults": fault_rows(run),
         "warnings": json.loads(run.attrs.get("warnings", "[]")) + navigation_warnings(run),
         "trajectories": list(run.trajectories),
+        "apogee_target": None if (target := apogee_target_m(run)) is None else apogee_about(run, target),
     }
 
 
@@ -433,6 +472,8 @@ def format_summary(summary: dict) -> str:
                    f"E {i['center_east_m'][0]:.1f}…{i['center_east_m'][1]:.1f} m")  # fmt: skip
     else:
         out.append("  not available: fewer than 3 ok impact points")
+    if summary["apogee_target"]:
+        out += ["", "Apogee against the air brakes' target (ok realizations)", "  " + format_apogee_about(summary["apogee_target"])]
     if summary["faults"]:
         out += ["", "Faults (/inputs/faults.*): the 95 % ellipse of the ok flights with and without the faulted ones"]
         out += text_table(["fault", "flights", "not ok", "area with [km^2]", "without [km^2]", "change", "centre with N, E [m]",

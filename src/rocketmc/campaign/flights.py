@@ -54,16 +54,21 @@ def _kept(state):
 
 def _deflections(p, state):
     """The canard deflections at the period start [rad]: the servos' with their offsets, or neutral."""
-    if p.gnc is None:
+    if p.gnc is None or p.gnc.servo is None:
         return jnp.zeros(p.rocket.aero.n_canards)
     return deflection_at(p.gnc.servo, state.gnc.servo, 0.0)
+
+
+def _deployment(state):
+    """The air brakes' deployment at the period start (None without air brakes)."""
+    return None if state.airbrakes is None else state.airbrakes.servo.deflection_rad
 
 
 def _at_start(p, state):
     """What the model computes at the start of the period beginning at ``state`` (SI, body FRD / NED)."""
     _, _, gust = period_gust(p, state)
     deflections = _deflections(p, state)
-    f = loads(state.t, state.body, p, deflections, gust, state.events)
+    f = loads(state.t, state.body, p, deflections, gust, state.events, _deployment(state))
     cp_x = centre_of_pressure_at(p.rocket.aero, f.air, f.mass.cg_x)
     return {
         "loads": f, "deflections": deflections,
@@ -79,7 +84,7 @@ def _power_at_end(p, start, end):
     """The aerodynamic force's power [W] at the end of the period from ``start`` to ``end``, with that period's
     gust and the events at its start (as its RK4 stages saw them)."""
     _, _, gust = period_gust(p, start)
-    f = loads(end.t, end.body, p, _deflections(p, end), gust, start.events)
+    f = loads(end.t, end.body, p, _deflections(p, end), gust, start.events, _deployment(end))
     return end.body.q_nb.rotate(f.aero_force_b).dot(end.body.v_n)
 
 
@@ -246,7 +251,14 @@ def _series(campaign: Campaign, states, samples, summary) -> tuple[pd.DataFrame,
                               "J", "½mV² + m·g0·altitude of the CG"),
         "aero_power": (samples["aero_power"], "W", "power of the aerodynamic force on the CG's motion, F·v"),
     }  # fmt: skip
-    if states.gnc is not None:
+    if states.airbrakes is not None:
+        brakes = states.airbrakes
+        columns["airbrake_deployment"] = (brakes.servo.deflection_rad, "1", "air brakes' deployment at the period start "
+                                          "(0 retracted, 1 fully out)")  # fmt: skip
+        columns["airbrake_command"] = (brakes.servo.command_rad, "1", "air brakes' command held over the period before")
+        columns["predicted_apogee"] = (brakes.predicted_apogee_m, "m", "the brakes' software's apogee prediction above the "
+                                       "pad at the period before's start (NaN while the brakes may not open)")  # fmt: skip
+    if states.gnc is not None and campaign.config.gnc.canards:
         for i in range(samples["deflections"].shape[1]):
             columns[f"canard_{i + 1}"] = (deg(samples["deflections"][:, i]), "deg", f"canard {i + 1} deflection, offset included")
         for a, name in zip("xyz", ("yaw", "pitch", "roll")):

@@ -84,7 +84,7 @@ def design_inputs(config: CampaignConfig, airframe: FlightParams) -> DesignInput
                           f"{aero.n_canards} (rocket.geometry.canards)")  # fmt: skip
     motor = airframe.rocket.motor
     times = jnp.arange(0.0, float(motor.ignition_time_s + motor.burn_time_s), ESTIMATE_DT_S)
-    mass, *arrays = _nominal_arrays(airframe, times, jnp.asarray(ESTIMATE_HEIGHTS_M))
+    mass, *arrays = nominal_arrays(airframe, times, jnp.asarray(ESTIMATE_HEIGHTS_M))
     guidance = config.gnc.guidance
     speeds, altitudes, climb = nominal_estimate(airframe, aero, *map(np.asarray, arrays), guidance.window_start_s,
                                                 guidance.window_end_s, guidance.t0_s)  # fmt: skip
@@ -118,7 +118,7 @@ def guidance_reference(config: CampaignConfig, launch: Launch, climb_m: float) -
 
 
 @jax.jit
-def _nominal_arrays(params: FlightParams, times, heights):
+def nominal_arrays(params: FlightParams, times, heights):
     """The nominal rocket's mass properties at burnout; thrust [N] and propellant mass [kg] at simulation
     ``times`` [s]; the air's density [kg/m³] and speed of sound [m/s] at ``heights`` above the pad [m]. One
     compilation (eagerly, XLA compiles each operation apart: seconds in a fresh process)."""
@@ -158,12 +158,39 @@ def nominal_estimate(params: FlightParams, aero: LinearAero, thrust_n, propellan
                      t0_s):  # fmt: skip
     """((min, max) speed [m/s], (min, max) altitude above the pad [m]) of the nominal flight off the
     rail (on it the rocket cannot turn) from ``start_s`` to ``end_s`` after liftoff (first motion), and its
-    climb from ``t0_s`` after liftoff to its apogee [m] (≤ 0 if it is past its apogee then, −inf if landed), estimated: a
-    point mass up the rail, then turning under gravity (thrust and drag along the velocity), with the thrust [N]
-    and propellant [kg] every ESTIMATE_DT_S from t = 0 to burnout, the zero-lift drag drag_scale·CA0(Mach) at the
-    pad's altitude (no power-on change, no airbrakes) and the air's density and speed of sound at
-    ESTIMATE_HEIGHTS_M; no wind. A host loop, ~30 ms for Lynx's window (~60 ms to its apogee). ConfigError if the
-    flight is not in the air in the window."""
+    climb from ``t0_s`` after liftoff to its apogee [m] (≤ 0 if it is past its apogee then, −inf if landed), from
+    ``point_mass_flight``. ConfigError if the flight is not in the air in the window."""
+    flight = point_mass_flight(params, aero, thrust_n, propellant_kg, density, sound, max(end_s, t0_s))
+    window = [(speed, z) for since, z, speed, on_rail in zip(flight.since_liftoff_s, flight.height_m, flight.speed_mps,
+                                                             flight.on_rail) if start_s <= since <= end_s and not on_rail]  # fmt: skip
+    if not window:
+        raise ConfigError(f"gnc.guidance.window_start_s: the nominal flight (a point-mass estimate) is not in the air "
+                          f"from {start_s:g} to {end_s:g} s after liftoff")  # fmt: skip
+    speeds, altitudes = zip(*window)
+    heights = flight.height_m
+    climb = max(heights) - float(np.interp(t0_s, flight.since_liftoff_s, heights, right=np.inf))  # −inf: landed by t0
+    return (float(min(speeds)), float(max(speeds))), (float(min(altitudes)), float(max(altitudes))), climb
+
+
+class PointMassFlight(NamedTuple):
+    """The nominal flight's point-mass estimate (``point_mass_flight``) every ESTIMATE_DT_S from liftoff: time since
+    liftoff [s]; height above the pad [m]; climb and horizontal speed [m/s]; speed [m/s]; on the rail (bool)."""
+
+    since_liftoff_s: list
+    height_m: list
+    climb_mps: list
+    horizontal_mps: list
+    speed_mps: list
+    on_rail: list
+
+
+def point_mass_flight(params: FlightParams, aero: LinearAero, thrust_n, propellant_kg, density, sound,
+                      until_s) -> PointMassFlight:  # fmt: skip
+    """The nominal flight estimated as a point mass up the rail, then turning under gravity (thrust and drag along
+    the velocity), with the thrust [N] and propellant [kg] every ESTIMATE_DT_S from t = 0 to burnout, the zero-lift
+    drag drag_scale·CA0(Mach) at the pad's altitude (no power-on change, no airbrakes) and the air's density and
+    speed of sound at ESTIMATE_HEIGHTS_M; no wind; from liftoff until past ``until_s`` after it and past its apogee,
+    or landed. A host loop, ~30 ms for Lynx's guidance window (~60 ms to its apogee)."""
     site = float(params.environment.site_altitude_m)
     heights = ESTIMATE_HEIGHTS_M
     mach_axis = np.asarray(aero.table.axes[aero.table.axis_names.index("mach")])
@@ -175,7 +202,7 @@ def nominal_estimate(params: FlightParams, aero: LinearAero, thrust_n, propellan
 
     dt = ESTIMATE_DT_S
     x = z = vx = vz = 0.0  # along the azimuth and up from the start [m], velocity [m/s]
-    liftoff, speeds, altitudes, times, heights_flown = None, [], [], [], []
+    liftoff, flown = None, PointMassFlight([], [], [], [], [], [])
     for k in itertools.count():
         burning = k < thrust_n.size
         if liftoff is None and not burning:
@@ -195,20 +222,13 @@ def nominal_estimate(params: FlightParams, aero: LinearAero, thrust_n, propellan
             liftoff = k * dt
         if liftoff is not None:
             since = k * dt - liftoff
-            if (since > max(end_s, t0_s) and vz < 0.0 and not on_rail) or (z < 0.0 and vz < 0.0):
-                break  # past the window, t0 and the apogee, or back on the ground
-            times.append(since)
-            heights_flown.append(z)
-            if start_s <= since <= end_s and not on_rail:
-                speeds.append(speed)
-                altitudes.append(z)
+            if (since > until_s and vz < 0.0 and not on_rail) or (z < 0.0 and vz < 0.0):
+                break  # past until_s and the apogee, or back on the ground
+            for values, value in zip(flown, (since, z, vz, vx, speed, on_rail)):
+                values.append(value)
         x, z = x + (vx + 0.5 * ax * dt) * dt, z + (vz + 0.5 * az * dt) * dt
         vx, vz = vx + ax * dt, vz + az * dt
-    if not speeds:
-        raise ConfigError(f"gnc.guidance.window_start_s: the nominal flight (a point-mass estimate) is not in the air "
-                          f"from {start_s:g} to {end_s:g} s after liftoff")  # fmt: skip
-    climb = max(heights_flown) - float(np.interp(t0_s, times, heights_flown, right=np.inf))  # −inf: landed by t0
-    return (float(min(speeds)), float(max(speeds))), (float(min(altitudes)), float(max(altitudes))), climb
+    return flown
 
 
 def describe_reference(reference: GuidanceReference) -> str:

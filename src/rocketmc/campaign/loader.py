@@ -33,6 +33,7 @@ from ..env.weather import Weather, WeatherError, read_weather
 from ..env.wind import read_wind_profile
 from ..math.table import Table
 from .errors import ConfigError, shown
+from .airbrakes import design_airbrakes
 from .gains import design_inputs, design_schedule
 from .limits import (
     DISPERSIBLE_SECTIONS,
@@ -60,7 +61,7 @@ from .schema import (
 def with_overrides(
     campaign: Campaign, n_realizations: int | None = None, seed: int | None = None, aero_model: str | None = None,
     controller: bool | None = None, sensors: bool | None = None, navigation: str | None = None,
-    values: Mapping[str, object] | None = None,
+    values: Mapping[str, object] | None = None, airbrakes: bool | None = None,
 ) -> Campaign:  # fmt: skip
     """``campaign`` loaded again by the one builder (``campaign_from_dict``: every check run, the gains designed
     again) from its validated tables with the overrides applied: N, the seed and/or the aerodynamic model replaced
@@ -69,12 +70,15 @@ def with_overrides(
     section of defaults (the thesis's parts) if there is none and flies the controller on raw sensors (or on its
     filters, if the campaign's navigation is "filters"), False removes it and its dispersions and flies the
     controller on perfect navigation (their faults removed too); navigation: the controller's ("truth", "sensors"
-    or "filters"), with sensors to match; values: fields set by dotted path (``{"avionics.gyroscope.truth_only":
+    or "filters"), with sensors to match; airbrakes: False removes the [airbrakes] (True is refused: they have no
+    defaults); values: fields set by dotted path (``{"avionics.gyroscope.truth_only":
     True}``), after the options above, and dispersions by their parameter's path after ``dispersions.``: a table
     sets one, None removes it. The result file's campaign text stays the file's; the overrides given (N and the seed
     apart) are added to ``Campaign.overrides``."""
     switched = {name: value for name, value in (("aero_model", aero_model), ("controller", controller),
-                ("sensors", sensors), ("navigation", navigation)) if value is not None}  # fmt: skip
+                ("sensors", sensors), ("navigation", navigation), ("airbrakes", airbrakes)) if value is not None}  # fmt: skip
+    if airbrakes:
+        raise ConfigError("airbrakes: there are no default air brakes to add; write an [airbrakes] section")
     if navigation is not None:
         sensors = navigation != "truth"
     data = campaign.config.model_dump()
@@ -84,6 +88,8 @@ def with_overrides(
     data.update({k: v for k, v in (("n_realizations", n_realizations), ("seed", seed)) if v is not None})
     if aero_model is not None:
         data["rocket"]["aero"]["model"] = aero_model
+    if airbrakes is False:
+        data["airbrakes"] = None
     for section, on in (("gnc", controller), ("avionics", sensors)):
         if on is not None and on != (data[section] is not None):
             data[section] = {} if on else None
@@ -347,11 +353,15 @@ def campaign_from_dict(raw: dict, base_dir: Path = Path("."), text: str = "") ->
     aero = _aero_model(config.rocket, base_dir)
     wind_profile, files, weather = _wind_profile(config, base_dir), _file_digests(config, base_dir), _weather(config, base_dir)
     schedule, inputs = None, None
-    if config.gnc is not None:
+    if config.gnc is not None and config.gnc.canards:
         inputs = design_inputs(config, airframe_params(config, time_s, thrust_n, aero, wind_profile, weather, nominal))
         schedule = design_schedule(config, inputs)
+    airbrakes, airbrake_design = None, None
+    if config.airbrakes is not None:
+        airframe = airframe_params(config, time_s, thrust_n, aero, wind_profile, weather, nominal)
+        airbrakes, airbrake_design = design_airbrakes(config, airframe)
     return Campaign(config, text, time_s, thrust_n, nominal, aero, base_dir, wind_profile, files, schedule, inputs,
-                    weather, motor=eng_header(path))  # fmt: skip
+                    weather, motor=eng_header(path), airbrakes=airbrakes, airbrake_design=airbrake_design)  # fmt: skip
 
 
 def _with_library_motor(rocket: dict) -> dict:
@@ -491,9 +501,10 @@ def _check_faults(config: CampaignConfig) -> None:
     [avionics]), and a bias jump on a sensor with errors (a truth-only sensor has no bias)."""
     for name in ({} if config.faults is None else config.faults.active()):
         section = FAULT_SECTIONS[name]
-        if getattr(config, section) is None:
-            acts_on = "the canard servos" if section == "gnc" else "the sensors"
-            raise ConfigError(f"faults.{name}: needs [{section}] ({acts_on} it acts on)")
+        if getattr(config, section) is None or (section == "gnc" and not config.gnc.canards):
+            acts_on = {"gnc": "the canard servos", "airbrakes": "the air brakes"}.get(section, "the sensors")
+            raise ConfigError(f"faults.{name}: needs [{section}] ({acts_on} it acts on)"
+                              + ("; gnc.canards is false" if getattr(config, section) is not None else ""))
         sensor = name.removesuffix("_bias_jump")
         if sensor != name and getattr(config.avionics, sensor).truth_only:
             raise ConfigError(f"faults.{name}: avionics.{sensor} is truth_only (no errors, so no bias to jump)")

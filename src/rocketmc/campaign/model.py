@@ -33,7 +33,7 @@ from ..env.magnetic import igrf_site_field_gradient, site_field_gradient, site_f
 from ..sensors.avionics import Avionics, Gnss, Magnetometer, Mounted
 from ..sensors.errors import Channel, noise_per_sample, walk_per_sample
 from ..sensors.parts import SENSORS
-from ..sim.faults import Faults, GnssOutage, SensorStep, SlowCanard, StuckCanard
+from ..sim.faults import Faults, GnssOutage, SensorStep, SlowCanard, StuckAirbrakes, StuckCanard
 from ..env.weather import Weather
 from ..sim.events import rail_start_n
 from ..sim.params import Environment, FlightParams, Launch, Rocket, SimSettings
@@ -78,7 +78,7 @@ def flight_params(campaign: Campaign, values: Mapping, key) -> FlightParams:
     environment = dataclasses.replace(airframe.environment, turbulence=_turbulence(cfg, v, key))
     avionics = _avionics(campaign, v, key, _body_x(cfg, v), airframe.rocket.aero.n_canards)
     return dataclasses.replace(airframe, environment=environment, gnc=_gnc(campaign, v), avionics=avionics,
-                               faults=_faults(campaign, v, avionics))  # fmt: skip
+                               faults=_faults(campaign, v, avionics), airbrakes=campaign.airbrakes)  # fmt: skip
 
 
 def airframe_params(
@@ -221,6 +221,9 @@ def _faults(campaign: Campaign, v: Mapping, avionics: Avionics | None) -> Faults
     if "slow_canard" in active:
         built["slow_canard"] = SlowCanard(at("slow_canard"), fin("slow_canard"),
                                           jnp.asarray(active["slow_canard"].factor))  # fmt: skip
+    if "stuck_airbrakes" in active:
+        jammed = active["stuck_airbrakes"].deployment
+        built["stuck_airbrakes"] = StuckAirbrakes(at("stuck_airbrakes"), None if jammed is None else jnp.asarray(jammed))
     if "gnss_outage" in active:
         built["gnss_outage"] = GnssOutage(at("gnss_outage", "start_s"), at("gnss_outage", "end_s"))
     if "magnetometer_step" in active:
@@ -241,6 +244,11 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
     gnc = campaign.config.gnc
     if gnc is None:
         return None
+    navigation = NavigationMode(gnc.navigation)
+    filters = filter_params(campaign) if navigation is NavigationMode.FILTERS else None
+    rail = (None, None) if navigation is NavigationMode.TRUTH else nominal_rail(campaign)
+    if not gnc.canards:
+        return GncParams(None, None, None, False, navigation, filters, *rail)
     s = "gnc.servo"
     rate_limit = gnc.servo.rate_limit_deg_s
     servo = ServoParams(
@@ -257,9 +265,6 @@ def _gnc(campaign: Campaign, v: Mapping) -> GncParams | None:
                       ("speed", "altitude"), GAIN_NAMES)  # fmt: skip
     else:
         table = Table((jnp.asarray(schedule.speeds),), jnp.asarray(gains[:, 0]), ("speed",), GAIN_NAMES)
-    navigation = NavigationMode(gnc.navigation)
-    filters = filter_params(campaign) if navigation is NavigationMode.FILTERS else None
-    rail = (None, None) if navigation is NavigationMode.TRUTH else nominal_rail(campaign)
     return GncParams(servo, guidance, table, gnc.control.anti_windup, navigation, filters, *rail)
 
 

@@ -40,7 +40,7 @@ def _parts(campaign: Campaign) -> tuple:
     """The trees of numbers a flight reads from the campaign, in ``with_numbers``'s order."""
     reference = None if campaign.gnc_inputs is None else campaign.gnc_inputs.reference
     return (campaign.nominal, campaign.thrust_time_s, campaign.thrust_n, campaign.aero, campaign.wind_profile,
-            campaign.weather, campaign.gnc_schedule, reference)  # fmt: skip
+            campaign.weather, campaign.gnc_schedule, reference, campaign.airbrakes)  # fmt: skip
 
 
 def _is_number(leaf) -> bool:
@@ -58,10 +58,11 @@ def with_numbers(campaign: Campaign, numbers) -> Campaign:
     leaves, tree = jax.tree_util.tree_flatten(_parts(campaign))
     given = iter(numbers)
     leaves = [next(given) if _is_number(leaf) else leaf for leaf in leaves]
-    nominal, time_s, thrust_n, aero, wind, weather, schedule, reference = jax.tree_util.tree_unflatten(tree, leaves)
+    nominal, time_s, thrust_n, aero, wind, weather, schedule, reference, airbrakes = jax.tree_util.tree_unflatten(tree, leaves)
     inputs = None if campaign.gnc_inputs is None else campaign.gnc_inputs._replace(reference=reference)
     return dataclasses.replace(campaign, nominal=nominal, thrust_time_s=time_s, thrust_n=thrust_n, aero=aero,
-                               wind_profile=wind, weather=weather, gnc_schedule=schedule, gnc_inputs=inputs)  # fmt: skip
+                               wind_profile=wind, weather=weather, gnc_schedule=schedule, gnc_inputs=inputs,
+                               airbrakes=airbrakes)  # fmt: skip
 
 
 def _argument_paths(config: dict, nominal: dict[str, float]) -> dict:

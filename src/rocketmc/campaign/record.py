@@ -11,6 +11,8 @@ from ..aero.model import LinearAero, TableAero
 from ..dynamics.motor_library import MotorEntry
 from ..env.weather import Weather
 from ..gnc.design import Schedule
+from ..gnc.airbrakes import AirbrakeParams
+from .airbrakes import AirbrakeDesign
 from .gains import DesignInputs
 from .schema import CampaignConfig
 
@@ -45,3 +47,7 @@ class Campaign:
     motor: MotorEntry | None = None
     """The motor its thrust curve's ``.eng`` header describes (the library's for a designation); None for a CSV or
     ``.rse`` curve, or a header that is not RASP's."""
+    airbrakes: AirbrakeParams | None = None
+    """With [airbrakes], the brakes and their flight software as every flight flies them (``campaign.airbrakes``)."""
+    airbrake_design: AirbrakeDesign | None = None
+    """With [airbrakes], what their gain was designed from."""

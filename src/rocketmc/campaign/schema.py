@@ -10,6 +10,7 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
+from ..aero.airbrakes import HOERNER_SQUARE_PLATE_CD
 from ..aero.geometry import DEFAULT_ROUGHNESS_M, FIN_PROFILES, NOSE_KINDS
 from ..env.magnetic import IGRF14_VALIDITY
 from ..env.wind import POWER_LAW_FLOOR_M
@@ -18,6 +19,10 @@ from .errors import shown
 from .limits import (
     DEFAULT_ALTITUDES_M,
     DEFAULT_SPEEDS_MPS,
+    MAX_AIRBRAKE_GAIN,
+    MAX_AIRBRAKE_MACH,
+    MAX_AIRBRAKE_PANELS,
+    MAX_AIRBRAKE_RATE_PER_S,
     MAX_ALTITUDE_M,
     MAX_ANOMALY_NT,
     MAX_BURN_TIME_S,
@@ -808,10 +813,79 @@ class GncConfig(_Strict):
     on the bus, ``filters``; needs [avionics])."""
 
     navigation: Literal["truth", "sensors", "filters"] = Field("truth", description="what the controller reads")
+    canards: bool = _added(
+        True, "false: the flight software's navigation alone, no canard controller (the canards neutral): what the air "
+        "brakes and the parachutes' triggers read on a rocket flown without steering"
+    )
     servo: ServoConfig = ServoConfig()
     guidance: GuidanceConfig = GuidanceConfig()
     control: ControlConfig = ControlConfig()
     filters: FiltersConfig = FiltersConfig()
+
+
+class AirbrakePanelsConfig(_Strict):
+    """Air-brake panels sliding out of the body: each a flat plate normal to the flow, ``count`` of them ``width_m``
+    wide and ``max_extension_m`` out at full deployment; ΔCA from Hoerner's plate drag and the stagnation pressure's
+    rise with Mach (``aero.airbrakes``)."""
+
+    count: int = Field(ge=1, le=MAX_AIRBRAKE_PANELS, description="number of panels")
+    width_m: Length = Field(description="each panel's width across the flow")
+    max_extension_m: Length = Field(description="how far each panel stands out of the body at full deployment")
+    cd: float = Field(HOERNER_SQUARE_PLATE_CD, gt=0, le=MAX_DRAG_COEFFICIENT,
+                      description="a panel's drag coefficient on its area at low Mach (Hoerner's square plate)")
+
+
+class AirbrakeTableConfig(_Strict):
+    """A team's own ΔCA (on the aerodynamic reference area) against deployment (0 … 1) and Mach: ``delta_ca[i][j]`` at
+    ``deployments[i]`` and ``machs[j]``, interpolated, clamped at the edges."""
+
+    deployments: list[Annotated[float, Field(ge=0, le=1)]] = Field(min_length=2, description="from 0 to 1, increasing")
+    machs: list[Mach] = Field(min_length=2, description="increasing")
+    delta_ca: list[list[DragCoefficient]] = Field(min_length=2, description="one row per deployment, one value per Mach")
+
+    @model_validator(mode="after")
+    def _grid(self):
+        if self.deployments[0] != 0.0 or self.deployments[-1] != 1.0 or np.any(np.diff(self.deployments) <= 0):
+            raise ValueError(f"deployments must increase from 0 to 1, got {self.deployments}")
+        if np.any(np.diff(self.machs) <= 0):
+            raise ValueError(f"machs must be strictly increasing, got {self.machs}")
+        if len(self.delta_ca) != len(self.deployments) or any(len(row) != len(self.machs) for row in self.delta_ca):
+            raise ValueError(f"delta_ca needs {len(self.deployments)} rows (deployments) of {len(self.machs)} values (machs)")
+        return self
+
+
+class AirbrakeServoConfig(_Strict):
+    """The deployment servo: first order 1/(τs + 1) from retracted (0) to fully out (1), optional slew-rate limit."""
+
+    time_constant_s: float = Field(0.1, gt=0, le=MAX_SERVO_TIME_CONSTANT_S, description="τ [s]")
+    rate_limit_per_s: float | None = Field(None, gt=0, le=MAX_AIRBRAKE_RATE_PER_S,
+                                           description="largest deployment rate [1/s] (none: no slew limit)")
+
+
+class AirbrakesControlConfig(_Strict):
+    """Air brakes and the flight software that flies them to a target apogee (docs/airbrakes.md): the drag they add
+    (``panels`` or ``table``), their servo, when they may open, and the controller: a ballistic prediction of the
+    apogee from the navigation ([gnc]'s, else the true state) with integral feedback on its error, its gain designed at
+    set-up for ``response_time_s`` unless ``gain_per_m_s`` is given (``rocketmc airbrakes design``). Fixed per
+    campaign."""
+
+    target_apogee_m: Height = Field(description="the apogee to reach, above the pad [m]")
+    panels: AirbrakePanelsConfig | None = Field(None, description="the drag from the panels' geometry")
+    table: AirbrakeTableConfig | None = Field(None, description="the drag from a team's own table")
+    servo: AirbrakeServoConfig = AirbrakeServoConfig()
+    max_mach: float = Field(0.8, gt=0, le=MAX_AIRBRAKE_MACH, description="the brakes stay in at or above this Mach")
+    after_burnout_s: float = Field(0.5, ge=0, le=MAX_FLIGHT_TIME_S,
+                                   description="the brakes may open this long after the nominal burnout [s]")
+    response_time_s: float = Field(1.0, gt=0, le=MAX_FLIGHT_TIME_S,
+                                   description="the time constant the gain is designed for at the nominal window's start [s]")
+    gain_per_m_s: float | None = Field(None, ge=0, le=MAX_AIRBRAKE_GAIN,
+                                       description="K_i [1/(m·s)] (none: designed for response_time_s)")
+
+    @model_validator(mode="after")
+    def _one_drag(self):
+        if (self.panels is None) == (self.table is None):
+            raise ValueError("give the brakes' drag as exactly one of panels or table")
+        return self
 
 
 DEFAULT_PART = "thesis"
@@ -1084,6 +1158,13 @@ class SlowCanardConfig(_CanardFault):
     factor: float = Field(ge=1, le=MAX_SLOW_FACTOR, description="its time constant's multiplier [-]")
 
 
+class StuckAirbrakesConfig(_TimedFault):
+    """Air brakes that stop moving at the fault time: frozen at their deployment then, or jammed at ``deployment``
+    (0: stuck retracted, 1: stuck fully out)."""
+
+    deployment: float | None = Field(None, ge=0, le=1, description="where they are stuck, 0 … 1 (none: where they were)")
+
+
 class GnssOutageConfig(_Fault):
     """No GNSS fix from a start drawn in ``start_s`` for a duration drawn in ``duration_s`` (uniform)."""
 
@@ -1124,6 +1205,7 @@ class FaultsConfig(_Strict):
     magnetometer_step: MagnetometerStepConfig | None = None
     gyroscope_bias_jump: GyroscopeBiasJumpConfig | None = None
     accelerometer_bias_jump: AccelerometerBiasJumpConfig | None = None
+    stuck_airbrakes: StuckAirbrakesConfig | None = _added(None, "the air brakes stuck from a time on (none: never)")
 
     def active(self) -> dict[str, _Fault]:
         """The faults some flight can have (given, probability above 0), by name in the table's order."""
@@ -1131,7 +1213,7 @@ class FaultsConfig(_Strict):
                 and f.probability > 0.0}  # fmt: skip
 
 
-FAULT_SECTIONS = {"stuck_canard": "gnc", "slow_canard": "gnc", "gnss_outage": "avionics",
+FAULT_SECTIONS = {"stuck_canard": "gnc", "slow_canard": "gnc", "stuck_airbrakes": "airbrakes", "gnss_outage": "avionics",
                   "magnetometer_step": "avionics", "gyroscope_bias_jump": "avionics",
                   "accelerometer_bias_jump": "avionics"}  # fmt: skip
 """The section each fault acts on: the canard servos of [gnc], the sensors of [avionics]."""
@@ -1151,6 +1233,9 @@ class CampaignConfig(_Strict):
     gnc: GncConfig | None = Field(None, description="the closed loop; None: no controller, canards neutral")
     avionics: AvionicsConfig | None = Field(None, description="the sensors; None: no sensors simulated")
     faults: FaultsConfig | None = Field(None, description="faults drawn per flight (docs/faults.md); None: none")
+    airbrakes: AirbrakesControlConfig | None = _added(
+        None, "air brakes flown to a target apogee by their flight software (docs/airbrakes.md); none: none"
+    )
 
     @field_validator("name")
     @classmethod
@@ -1159,3 +1244,9 @@ class CampaignConfig(_Strict):
             raise ValueError(f"expected a label: 1 to {MAX_NAME_LENGTH} printable characters on one line, not blank")
         return name
 
+
+    @model_validator(mode="after")
+    def _one_kind_of_airbrakes(self):
+        if self.airbrakes is not None and self.rocket.airbrakes is not None:
+            raise ValueError("airbrakes: the rocket has a drag schedule already (rocket.airbrakes): fly one or the other")
+        return self

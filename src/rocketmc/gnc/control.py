@@ -40,7 +40,8 @@ GAIN_NAMES = tuple(f"K{i}{j}" for i in range(N_INPUT) for j in range(N_STATE))
 
 @pytree_dataclass
 class GncParams:
-    """servo: the canard servos; guidance: the reference and the rate command; gains: ``Table`` of K over
+    """servo: the canard servos; guidance: the reference and the rate command (these and the gains None: navigation
+    alone, no canard controller, ``gnc.canards = false``); gains: ``Table`` of K over
     ``speed`` (axial body speed u [m/s]) and, when the design grid has several, ``altitude`` (above mean sea
     level [m]), outputs ``GAIN_NAMES`` (clamped at the grid's edges); anti_windup: conditional integration
     (``gnc_step``; static); navigation: what the controller reads (``NavigationMode``; static); filters: the
@@ -48,9 +49,9 @@ class GncParams:
     launch, the campaign's nominal rail: its attitude (body → NED) and the CG's position at rest on it [m, NED],
     where navigation from the sensors starts (None with TRUTH)."""
 
-    servo: ServoParams
-    guidance: GuidanceParams
-    gains: Table
+    servo: ServoParams | None
+    guidance: GuidanceParams | None
+    gains: Table | None
     anti_windup: bool = static_field()
     navigation: NavigationMode = static_field()
     filters: FilterParams | None = None
@@ -125,14 +126,14 @@ def initial_gnc(params: GncParams, like) -> GncState:
     (``params.navigation`` SENSORS or FILTERS) at the nominal rail (``params.rail_q_nb``, ``rail_r_n``); ``like``
     a scalar of the flight's dtype."""
     zero = jnp.zeros_like(like)
-    fins = jnp.zeros_like(params.servo.offset_rad)
+    fins = jnp.zeros(0) if params.servo is None else jnp.zeros_like(params.servo.offset_rad)
     q_nb0, r_n0 = params.rail_q_nb, params.rail_r_n
     navigation = {NavigationMode.TRUTH: lambda: None,
                   NavigationMode.SENSORS: lambda: initial_dead_reckoning(q_nb0),
                   NavigationMode.FILTERS: lambda: initial_filters(params.filters, q_nb0, r_n0)}[params.navigation]()  # fmt: skip
     recovery = (None if params.navigation is NavigationMode.TRUTH
                 else Recovery(jnp.zeros_like(zero, dtype=jnp.int32), zero + jnp.inf, zero))  # fmt: skip
-    wind_n = None if params.guidance.wind_gain is None else Vec3(zero, zero, zero)
+    wind_n = None if params.guidance is None or params.guidance.wind_gain is None else Vec3(zero, zero, zero)
     return GncState(
         ServoState(fins, fins), Vec3(zero, zero, zero), zero + jnp.inf, Vec3(zero, zero, zero),
         jnp.zeros_like(zero, dtype=bool),
@@ -270,7 +271,10 @@ def track_navigation(params: GncParams, state: GncState, t, dt, canopy, body: Ri
     bool), and at the first tick ``burnt`` and ``past_apogee`` (bool). Other navigation: ``state`` itself."""
     if params.navigation is not NavigationMode.FILTERS:
         return state
-    window = guidance_active(params.guidance, t - state.liftoff_time) & ~jnp.asarray(canopy)  # canopy: False without parachutes
+    if params.guidance is None:  # no controller, no window
+        window = jnp.zeros_like(t, dtype=bool)
+    else:
+        window = guidance_active(params.guidance, t - state.liftoff_time) & ~jnp.asarray(canopy)  # canopy: False without parachutes
     navigation = track_errors(state.navigation, body.q_nb, body.r_n, body.v_n, gyroscope_bias_b(av, sensed),
                               jnp.where(window, dt, 0.0), jnp.where(ascent, dt, 0.0), burnt, past_apogee)  # fmt: skip
     return dataclasses.replace(state, navigation=navigation)
@@ -279,8 +283,8 @@ def track_navigation(params: GncParams, state: GncState, t, dt, canopy, body: Ri
 def gnc_summary(params: GncParams, state: GncState, burnout_speed_mps) -> tuple[dict, jnp.ndarray | None]:
     """The closed loop's per-flight outputs: the controller's (``control_summary``) and, on the FILTERS, theirs
     (``navigation.navigation_summary``, with the burnout speed [m/s]); and whether the filters failed (bool; None
-    on other navigation)."""
-    summary = control_summary(state)
+    on other navigation). Navigation alone (no gains) has no controller's outputs."""
+    summary = {} if params.gains is None else control_summary(state)
     if params.navigation is not NavigationMode.FILTERS:
         return summary, None
     return {**summary, **navigation_summary(state.navigation, burnout_speed_mps)}, state.navigation.failed

@@ -1,4 +1,4 @@
-"""Faults of one flight (docs/faults.md): the canard servos and the sensors as they fail, on the truth.
+"""Faults of one flight (docs/faults.md): the canard servos, the air brakes and the sensors as they fail, on the truth.
 
 A fault acts from the first GNC period that starts at or after its time (its time ``inf``: never): the servos'
 state and time constant are set at the period start, the sensors sample at the period start. What the navigation
@@ -38,6 +38,15 @@ class SlowCanard:
 
 
 @pytree_dataclass
+class StuckAirbrakes:
+    """time_s: from when [s] (inf: never); deployment: where they jam, 0 … 1 (None: where they were; a static
+    choice)."""
+
+    time_s: jnp.ndarray
+    deployment: jnp.ndarray | None = None
+
+
+@pytree_dataclass
 class GnssOutage:
     """No fix is taken from start_s to end_s [s] (inf: never)."""
 
@@ -64,6 +73,7 @@ class Faults:
     magnetometer_step: SensorStep | None = None
     gyroscope_bias_jump: SensorStep | None = None
     accelerometer_bias_jump: SensorStep | None = None
+    stuck_airbrakes: StuckAirbrakes | None = None
 
     @property
     def servos(self) -> bool:
@@ -91,6 +101,15 @@ def faulty_servos(faults: Faults, params: ServoParams, state: ServoState, t) -> 
                                                                                     state.deflection_rad)  # fmt: skip
         state = ServoState(deflection, jnp.where(now, deflection, state.command_rad))
     return params, state
+
+
+def stuck_airbrakes(stuck: StuckAirbrakes, state: ServoState, t) -> ServoState:
+    """The air brakes' servo over the period starting at ``t`` [s], its command held: from the fault on, the command set
+    to the deployment, which then stays as it is bit for bit (as a stuck canard), or both set to the jammed deployment."""
+    now = t >= stuck.time_s
+    deployment = state.deflection_rad if stuck.deployment is None else jnp.where(now, stuck.deployment,
+                                                                                  state.deflection_rad)  # fmt: skip
+    return ServoState(deployment, jnp.where(now, deployment, state.command_rad))
 
 
 def faulty_sensors(faults: Faults, av: Avionics, t) -> Avionics:

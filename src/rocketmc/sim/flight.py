@@ -22,12 +22,13 @@ from ..dynamics import RigidBodyState
 from ..dynamics.rigid_body import normalize_attitude
 from ..dynamics.servo import deflection_at, end_of_period
 from ..env import advance_turbulence, gust_n, initial_turbulence, turbulence_noise, turbulence_scales
-from ..gnc.control import gnc_step, initial_gnc, navigate, track_navigation
+from ..gnc.airbrakes import AirbrakeState, airbrake_step, initial_airbrakes
+from ..gnc.control import gnc_step, initial_gnc, navigate, track_navigation, truth
 from ..math import Vec3, rk4_step, safe_sqrt
 from ..sensors.avionics import avionics_noise, initial_avionics, sense, sense_acceleration, specific_force_b
 from ..pytree import tree_where
 from .events import rail_start_n, rail_travel_m, update_events
-from .faults import faulty_servos, faulty_sensors
+from .faults import faulty_servos, faulty_sensors, stuck_airbrakes
 from .loads import derivatives, mass_properties
 from .outputs import flight_summary
 from .params import FlightParams, SimSettings
@@ -48,8 +49,9 @@ def initial_state(p: FlightParams) -> FlightState:
     filters = None if turbulence is None else initial_turbulence(turbulence)
     gnc = None if p.gnc is None else initial_gnc(p.gnc, zero)
     avionics = None if p.avionics is None else initial_avionics(p.avionics, zero)
+    airbrakes = None if p.airbrakes is None else initial_airbrakes(zero)
     return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, Canopy(zero, zero), filters, gnc,
-                       avionics)  # fmt: skip
+                       avionics, airbrakes)  # fmt: skip
 
 
 def steady_descent(p: FlightParams, settings: SimSettings, state: FlightState):
@@ -152,7 +154,8 @@ def regular_period_s(p: FlightParams, settings: SimSettings) -> float:
 
 
 def _events_end_periods(p: FlightParams, settings: SimSettings) -> bool:
-    return settings.event_periods and p.gnc is None and p.avionics is None  # with them, each period is a GNC tick
+    # with them, each period is a GNC tick
+    return settings.event_periods and p.gnc is None and p.avionics is None and p.airbrakes is None
 
 
 EVENT_OVERSHOOT = 0.01
@@ -208,7 +211,7 @@ def period_gust(p: FlightParams, state: FlightState):
 
 def control_step(
     p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightState, period, deflections, noise=None,
-    first_stage: bool = False, point_mass=False,
+    first_stage: bool = False, point_mass=False, deployment=None,
 ) -> tuple[FlightState, jnp.ndarray | None]:  # fmt: skip
     """One control period of ``period`` [s] (``control_period``) with the turbulent gust held: RK4 substeps
     of the rigid body with events, then the turbulence filters advanced over the period with ``noise``,
@@ -219,7 +222,8 @@ def control_step(
     (8,) array, else None.
 
     deflections: the canard deflections δ1..δn [rad] as a function of the time t [s] inside the
-    period (held, or the servos' response evaluated at each RK4 stage).
+    period (held, or the servos' response evaluated at each RK4 stage); deployment: the air brakes' (0 … 1), a
+    function of t too (None without air brakes).
     """
     h = period / settings.substeps
     turbulence = p.environment.turbulence
@@ -228,7 +232,8 @@ def control_step(
     sensed = None if recovery is None else (recovery.height_error_m, jnp.isfinite(recovery.apogee_time))
 
     def rhs(t, y, events):
-        d_body, diag = derivatives(t, y, p, deflections(t), gust, events, point_mass)
+        brakes = None if deployment is None else deployment(t)
+        d_body, diag = derivatives(t, y, p, deflections(t), gust, events, point_mass, brakes)
         if not first_stage:
             return d_body, (diag, None)
         # one array, not a pytree: RK4 keeps its first stage's by-products with a select per leaf and stage; the CG
@@ -257,7 +262,8 @@ def control_step(
     if turbulence is not None:
         airspeed = (state.body.v_n - mean_wind_n - gust).norm()
         filters = advance_turbulence(filters, scales, airspeed, period, noise)
-    return FlightState(state.t + period, state.tick + 1, body, events, canopy, filters, state.gnc, state.avionics), first
+    return FlightState(state.t + period, state.tick + 1, body, events, canopy, filters, state.gnc, state.avionics,
+                       state.airbrakes), first  # fmt: skip
 
 
 class StepNoise(NamedTuple):
@@ -275,20 +281,24 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
     noise: the period's ``StepNoise``; canard_command: open-loop deflections, a function of time [s]
     returning δ1..δn [rad] held over the period (None: neutral, or the closed loop's when ``p.gnc`` is set:
     guidance and control at the period start, the servos' response inside it; navigating from the sensors, the
-    LQI reads the canard feedback and the parachutes trigger on the navigation: ``gnc.control.navigate``)."""
+    LQI reads the canard feedback and the parachutes trigger on the navigation: ``gnc.control.navigate``). The air
+    brakes (``p.airbrakes``) read the closed loop's navigation, or the truth without one (``_airbrakes``)."""
     period, point_mass = control_period(p, settings, start_n, state)
     sensing = (period <= settings.control_dt_s) & ~jnp.asarray(point_mass)  # GNC periods only, not long or point-mass ones
     if p.gnc is None:
         held = jnp.zeros(p.rocket.aero.n_canards) if canard_command is None else canard_command(state.t)
         held = jnp.asarray(held, dtype=float)
         start = _sensed(p, state, held, sensing, noise)
+        brakes, deployment = _airbrakes(p, settings, start, *truth(start.body), _canopy(start.events.chute_trigger_times))
         state, first = control_step(p, settings, start_n, start, period, lambda t: held, noise.turbulence,
-                                    p.avionics is not None, point_mass)  # fmt: skip
-        return _accelerometer(p, start, state, first, sensing, noise)
+                                    p.avionics is not None, point_mass, deployment)  # fmt: skip
+        return _accelerometer(p, start, _with_airbrakes(p, state, brakes, period), first, sensing, noise)
     if canard_command is not None:
         raise ValueError("canard_command flies open loop: it needs a flight without a controller (p.gnc None)")
     servo_params, t0 = p.gnc.servo, state.t
-    state = start = _sensed(p, state, state.gnc.servo.deflection_rad, sensing, noise)
+    steering = p.gnc.gains is not None  # else the navigation alone (gnc.canards false), the canards neutral
+    neutral = jnp.zeros(p.rocket.aero.n_canards)
+    state = start = _sensed(p, state, state.gnc.servo.deflection_rad if steering else neutral, sensing, noise)
     canopy = _canopy(state.events.chute_trigger_times)
     navigated = navigate(p.gnc, p.avionics, state.gnc, state.body, state.avionics, t0, canopy,
                          [chute.trigger_altitude_agl_m for chute in p.rocket.parachutes],
@@ -299,22 +309,47 @@ def step(p: FlightParams, settings: SimSettings, start_n: Vec3, state: FlightSta
         triggered = dataclasses.replace(events, chute_trigger_times=navigated.trigger_times)
         events = tree_where(done(state), events, triggered)
     state = dataclasses.replace(state, gnc=navigated.state, events=events)
-    altitude_msl = p.environment.site_altitude_m - nav.r_n.z
-    gnc = gnc_step(p.gnc, state.gnc, nav, navigated.moving, t0, settings.control_dt_s, altitude_msl, canopy,
-                   navigated.feedback_rad)  # fmt: skip
+    gnc = state.gnc
+    if steering:
+        altitude_msl = p.environment.site_altitude_m - nav.r_n.z
+        gnc = gnc_step(p.gnc, gnc, nav, navigated.moving, t0, settings.control_dt_s, altitude_msl, canopy,
+                       navigated.feedback_rad)  # fmt: skip
     body = state.body
     ascent = (body.v_n.dot(body.v_n) > 0.0) & jnp.isinf(events.apogee_time)
     gnc = track_navigation(p.gnc, gnc, t0, settings.control_dt_s, canopy, body, _avionics_at(p, t0), state.avionics,
                            ascent, t0 >= events.burnout_time, t0 >= events.apogee_time)  # fmt: skip
-    held = gnc.servo
-    if p.faults is not None and p.faults.servos:
-        servo_params, held = faulty_servos(p.faults, servo_params, held, t0)
-    servo = end_of_period(servo_params, held, period)
-    state, first = control_step(p, settings, start_n, state, period,
-                                lambda t: deflection_at(servo_params, held, t - t0), noise.turbulence,
-                                p.avionics is not None, point_mass)  # fmt: skip
-    state = dataclasses.replace(state, gnc=dataclasses.replace(gnc, servo=servo))
-    return _accelerometer(p, start, state, first, sensing, noise)
+    brakes, deployment = _airbrakes(p, settings, state, nav, navigated.moving, canopy)
+    deflections = lambda t: neutral  # noqa: E731
+    if steering:
+        held = gnc.servo
+        if p.faults is not None and p.faults.servos:
+            servo_params, held = faulty_servos(p.faults, servo_params, held, t0)
+        gnc = dataclasses.replace(gnc, servo=end_of_period(servo_params, held, period))
+        deflections = lambda t: deflection_at(servo_params, held, t - t0)  # noqa: E731
+    state, first = control_step(p, settings, start_n, state, period, deflections, noise.turbulence,
+                                p.avionics is not None, point_mass, deployment)  # fmt: skip
+    state = dataclasses.replace(state, gnc=gnc)
+    return _accelerometer(p, start, _with_airbrakes(p, state, brakes, period), first, sensing, noise)
+
+
+def _airbrakes(p: FlightParams, settings: SimSettings, state: FlightState, nav, moving, canopy):
+    """The air brakes at the period start ``state`` (``gnc.airbrakes.airbrake_step`` on the navigation solution
+    ``nav``, ``moving`` and ``canopy`` as it sees them; stuck once their fault happened: ``sim.faults``) and their
+    deployment over the period, a function of the time [s]; (None, None) without air brakes."""
+    if p.airbrakes is None:
+        return None, None
+    brakes = airbrake_step(p.airbrakes, state.airbrakes, nav, moving, state.t, settings.control_dt_s, canopy)
+    if p.faults is not None and p.faults.stuck_airbrakes is not None:
+        brakes = dataclasses.replace(brakes, servo=stuck_airbrakes(p.faults.stuck_airbrakes, brakes.servo, state.t))
+    return brakes, lambda t: deflection_at(p.airbrakes.servo, brakes.servo, t - state.t)
+
+
+def _with_airbrakes(p: FlightParams, state: FlightState, brakes: AirbrakeState | None, period) -> FlightState:
+    """``state``, the period's end, with the air brakes' servo ``period`` [s] after ``brakes`` (no change without)."""
+    if brakes is None:
+        return state
+    servo = end_of_period(p.airbrakes.servo, brakes.servo, period)
+    return dataclasses.replace(state, airbrakes=dataclasses.replace(brakes, servo=servo))
 
 
 def _canopy(trigger_times):

@@ -12,6 +12,7 @@ from ..aero import AirData, aero_coefficients, aero_wrench, air_data
 from ..dynamics import RigidBodyState, open_fraction, parachute_drag_n, propellant_mass, rigid_body_derivatives, thrust
 from ..dynamics.propulsion import grain_inertia
 from ..dynamics.rigid_body import MassProperties, combine_on_axis
+from ..gnc.airbrakes import delta_ca as airbrake_delta_ca
 from ..math import Quat, Vec3
 from ..pytree import tree_where
 from .params import FlightParams
@@ -47,9 +48,11 @@ class Loads(NamedTuple):
     outside_tables: jnp.ndarray
 
 
-def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events) -> Loads:
-    """The ``Loads`` at ``t`` [s] on ``body`` with canard deflections δ1..δn [rad] and a turbulent gust
-    ``gust_n`` [m/s, NED] on top of the mean wind (``derivatives``' forces, also read by ``analysis``)."""
+def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events,
+          deployment=None) -> Loads:  # fmt: skip
+    """The ``Loads`` at ``t`` [s] on ``body`` with canard deflections δ1..δn [rad], a turbulent gust
+    ``gust_n`` [m/s, NED] on top of the mean wind and the air brakes' ``deployment`` (0 … 1; with ``p.airbrakes``)
+    (``derivatives``' forces, also read by ``analysis``)."""
     rocket, env = p.rocket, p.environment
     mass = mass_properties(p, t)
     altitude = -body.r_n.z
@@ -84,6 +87,8 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
         since_ignition = t - rocket.motor.ignition_time_s
         delta_ca = jnp.interp(since_ignition, rocket.airbrake_time_s, rocket.airbrake_delta_ca, left=0.0, right=0.0)
         coefficients = coefficients._replace(ca=coefficients.ca + delta_ca)
+    if p.airbrakes is not None:
+        coefficients = coefficients._replace(ca=coefficients.ca + airbrake_delta_ca(p.airbrakes, deployment, air.mach))
     aero_force_b, aero_moment_b = aero_wrench(rocket.aero, coefficients, air, omega_b, rocket.canopy_cl_p, under_canopy)
     aero_arm_b = Vec3(rocket.aero.moment_ref_x_m - mass.cg_x, 0.0, 0.0)
     moment_b = moment_b + aero_moment_b + aero_arm_b.cross(aero_force_b)
@@ -92,11 +97,12 @@ def loads(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, e
 
 
 def derivatives(t, body: RigidBodyState, p: FlightParams, deflections, gust_n: Vec3, events: Events,
-                point_mass=False):  # fmt: skip
-    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad] and a
-    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind; point_mass (bool): the body's attitude and rates
-    held, its CG moved by every force (steady descent: ``sim.flight.steady_descent``)."""
-    f = loads(t, body, p, deflections, gust_n, events)
+                point_mass=False, deployment=None):  # fmt: skip
+    """State derivative and ``Diagnostics`` at ``t`` with canard deflections δ1..δn [rad], a
+    turbulent gust ``gust_n`` [m/s, NED] on top of the mean wind and the air brakes' ``deployment`` (``loads``);
+    point_mass (bool): the body's attitude and rates held, its CG moved by every force (steady descent:
+    ``sim.flight.steady_descent``)."""
+    f = loads(t, body, p, deflections, gust_n, events, deployment)
     force_b = f.aero_force_b + Vec3(f.thrust_n, 0.0, 0.0)
     gravity = p.environment.gravity_mps2(p.environment.site_altitude_m - body.r_n.z)
     free = rigid_body_derivatives(body, f.mass, force_b, f.chute_force_n, f.moment_b, gravity)

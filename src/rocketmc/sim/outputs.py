@@ -8,6 +8,7 @@ from typing import NamedTuple
 import jax.numpy as jnp
 
 from ..env.atmosphere import MAX_ALTITUDE_M
+from ..gnc.airbrakes import airbrake_summary
 from ..gnc.control import gnc_summary
 from ..gnc.navigation import DIVERGED_MEANING
 from .params import FlightParams
@@ -72,12 +73,22 @@ NAVIGATION_METRICS: dict[str, Metric] = {
 """The outputs a flight on the navigation filters adds (``gnc.navigation.navigation_summary``); NaN where their span
 never came."""
 
+AIRBRAKE_METRICS: dict[str, Metric] = {
+    "apogee_error_m": Metric("m", "apogee above the pad less the air brakes' target (NaN: no apogee)"),
+    "airbrake_active_time_s": Metric("s", "time the air brakes were allowed: after burnout, below their Mach limit, climbing"),
+    "airbrake_deployment_time_s": Metric("s", "the air brakes' deployment integrated over time: seconds at full deployment"),
+    "airbrake_saturated_fraction": Metric(
+        "1", "fraction of the allowed time fully deployed with the predicted apogee still above the target"
+    ),
+}
+"""The outputs a flight with air brakes adds (``gnc.airbrakes.airbrake_summary``); NaN where they never acted."""
+
 DEPLOY_TIME_SUFFIX = "_deploy_time_s"
 
 
 def metric(name: str) -> Metric:
     """The ``Metric`` of output ``name``: from ``METRICS`` or a parachute's ``<name>_deploy_time_s``."""
-    every = {**METRICS, **CONTROL_METRICS, **NAVIGATION_METRICS}
+    every = {**METRICS, **CONTROL_METRICS, **NAVIGATION_METRICS, **AIRBRAKE_METRICS}
     if name in every:
         return every[name]
     if not name.endswith(DEPLOY_TIME_SUFFIX):
@@ -119,6 +130,8 @@ def flight_summary(p: FlightParams, state: FlightState) -> tuple[dict, jnp.ndarr
         closed_loop, navigation_failed = gnc_summary(p.gnc, state.gnc, summary["burnout_speed_mps"])
         summary.update(closed_loop)
         failed = [] if navigation_failed is None else [navigation_failed]
+    if state.airbrakes is not None:
+        summary.update(airbrake_summary(p.airbrakes, state.airbrakes, summary["apogee_agl_m"]))
     outside = ev.max_qbar_outside_tables > OUTSIDE_TABLES_QBAR_FRACTION * ev.max_qbar
     too_high = p.environment.site_altitude_m + ev.apogee_altitude > MAX_ALTITUDE_M
     status = jnp.select(

@@ -8,6 +8,7 @@ import jax.numpy as jnp
 
 from ..aero import LinearAero, TableAero
 from ..dynamics import Motor, Parachute
+from ..gnc.airbrakes import AirbrakeParams
 from ..gnc.control import GncParams
 from ..sensors.avionics import Avionics
 from ..env import PowerLawWind, Turbulence, WindLayers, WindProfile
@@ -86,7 +87,8 @@ class Environment:
 class FlightParams:
     """Everything one realization needs (all leaves dynamic: they can be dispersed); gnc: the closed
     loop (None: canards neutral, and no cost); avionics: the sensors (None: none simulated, and no cost); faults:
-    the servos' and sensors' faults (``sim.faults``; None: none, and no cost)."""
+    the servos' and sensors' faults (``sim.faults``; None: none, and no cost); airbrakes: the air brakes and their
+    flight software (``gnc.airbrakes``; None: none, and no cost)."""
 
     rocket: Rocket
     launch: Launch
@@ -94,6 +96,7 @@ class FlightParams:
     gnc: GncParams | None = None
     avionics: Avionics | None = None
     faults: Faults | None = None
+    airbrakes: AirbrakeParams | None = None
 
 
 @dataclasses.dataclass(frozen=True)

@@ -11,6 +11,7 @@ import jax.numpy as jnp
 from ..dynamics import RigidBodyState
 from ..env import TurbulenceState
 from ..env.atmosphere import MAX_ALTITUDE_M
+from ..gnc.airbrakes import AirbrakeState
 from ..gnc.control import GncState
 from ..pytree import pytree_dataclass
 from ..sensors.avionics import AvionicsState
@@ -88,7 +89,8 @@ class Canopy(NamedTuple):
 class FlightState:
     """Time [s], the control-period counter, rigid-body state, the event record, the ``Canopy`` rates at the end
     of the last period (they bound the descent's periods), the turbulence filters (None without turbulence), the
-    closed loop's state (None without a controller) and the avionics' (None without sensors).
+    closed loop's state (None without a controller), the avionics' (None without sensors) and the air brakes' (None
+    without them).
 
     tick: control periods flown (int32, +1 per ``control_step``, after landing too, as ``t``). A longer period of
     steady descent (``steady_descent``: the GNC idle) counts one too, as does,
@@ -103,6 +105,7 @@ class FlightState:
     turbulence: TurbulenceState | None
     gnc: GncState | None = None
     avionics: AvionicsState | None = None
+    airbrakes: AirbrakeState | None = None
 
 
 class Diagnostics(NamedTuple):
