@@ -89,8 +89,8 @@ def test_prediction_against_scipy(brakes, deployment):
     height, climb, horizontal = 949.0, 291.0, 44.0
     reference = solve_ivp(rates, (0.0, 60.0), [height, climb, horizontal], events=apogee, rtol=1e-11, atol=1e-9)
     predicted = float(jax.jit(predicted_apogee_m)(brakes, height, climb, horizontal, deployment))
-    # PREDICTION_STEPS RK4 steps and a linear crossing: measured within 0.35 m of these 2.4 km climbs (its docstring)
-    assert predicted == pytest.approx(reference.y_events[0][0][0], abs=0.5)
+    # PREDICTION_STEPS RK4 steps and a linear crossing: measured within 1.6 m of these 2.4 km climbs (its docstring)
+    assert predicted == pytest.approx(reference.y_events[0][0][0], abs=2.0)
 
 
 def _nav(height, climb, horizontal=0.0):

@@ -29,11 +29,14 @@ from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
 from .guidance import Navigation
 
-PREDICTION_STEPS = 20
-"""RK4 steps of the apogee prediction, over the drag-free time to apogee w/g (the coast with drag is shorter). Against
-scipy's solve_ivp of the same model (rtol 1e-11), Lynx's EuRoC coasts from 949, 2000 and 2800 m, retracted, 40 % and
-fully deployed: within 0.35 m (12 steps: 2.4 m, the CA table's kinks across Mach 0.8-0.9 cost RK4 its order; 60
-steps: 0.04 m)."""
+PREDICTION_STEPS = 10
+"""RK4 steps of the apogee prediction over its horizon (``predicted_apogee_m``). Against scipy's solve_ivp of the same
+model (rtol 1e-11), Lynx's EuRoC coasts from 949, 2000 and 2800 m, retracted, 40 % and fully deployed: within 1.6 m
+(0.07 % of a 2.1 km climb; 8 steps 3.4 m, 12 steps 0.9 m), the largest from burnout, where the climb crosses the CA
+table's kinks about Mach 0.8-0.9 and RK4 loses its order; a tenth of the navigation's and the drag's errors."""
+HORIZON_MARGIN = 1.3
+"""The prediction's horizon over the vertical constant-drag coast's time to apogee: the thinning air makes the real
+coast longer (Lynx's EuRoC coast from burnout: ~1.1x)."""
 
 
 @pytree_dataclass
@@ -87,40 +90,47 @@ def delta_ca(params: AirbrakeParams, deployment, mach):
 def predicted_apogee_m(params: AirbrakeParams, height_m, climb_mps, horizontal_mps, deployment):
     """The apogee above the pad [m] of a point mass (``coast_mass_kg``) coasting from ``height_m`` above the pad at
     ``climb_mps`` up and ``horizontal_mps`` [m/s], drag ½ρV²S(CA(M) + ΔCA(deployment, M)) along the velocity, the
-    ISA's air, gravity G0, no wind: ``prediction_steps`` RK4 steps over w/g, the crossing of w = 0 interpolated
-    (``height_m`` itself if not climbing)."""
+    ISA's air, gravity G0, no wind (``height_m`` itself if not climbing).
+
+    ``prediction_steps`` RK4 steps over a horizon T that covers the coast: the vertical coast's time to apogee under
+    quadratic drag at the start's drag constant k, atan(w·√(k/g))/√(k·g) (the air thins as it climbs, so the real coast
+    is longer), times ``HORIZON_MARGIN``, at most the drag-free w/g. The crossing of w = 0 is interpolated in its step;
+    a climb still going at T adds the drag-free w²/2g."""
     area, mass = params.reference_area_m2, params.coast_mass_kg
 
-    def rates(state):
-        h, w, u = state
+    def rates(h, w, u):
         air = isa(params.site_altitude_m + h)
         speed = safe_sqrt(w * w + u * u)
         mach = speed / air.speed_of_sound
         ca = interpolate(params.known_ca, (mach,))[0][0] + delta_ca(params, deployment, mach)
         per_speed = 0.5 * air.density * speed * area * ca / mass  # drag acceleration over the speed [1/s]
-        return jnp.stack([w, -G0 - per_speed * w, -per_speed * u])
+        return w, -G0 - per_speed * w, -per_speed * u, per_speed / jnp.maximum(speed, 1e-9)
 
     climbing = climb_mps > 0.0
     w0 = jnp.where(climbing, climb_mps, 1.0)
-    dt = w0 / G0 / params.prediction_steps
+    u0 = horizontal_mps + 0.0 * height_m
+    k = rates(height_m, w0, u0)[3]  # the drag constant [1/m]: drag acceleration = k·V²
+    root = safe_sqrt(k * G0)
+    coast = jnp.where(root > 0.0, jnp.arctan(w0 * root / G0) / jnp.where(root > 0.0, root, 1.0), w0 / G0)
+    dt = jnp.minimum(HORIZON_MARGIN * coast, w0 / G0) / params.prediction_steps
 
     def rk4(carry, _):
-        state, apogee, crossed = carry
-        k1 = rates(state)
-        k2 = rates(state + 0.5 * dt * k1)
-        k3 = rates(state + 0.5 * dt * k2)
-        k4 = rates(state + dt * k3)
-        new = state + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        (h, w, u), apogee, crossed = carry
+        k1 = rates(h, w, u)[:3]
+        k2 = rates(*(x + 0.5 * dt * d for x, d in zip((h, w, u), k1)))[:3]
+        k3 = rates(*(x + 0.5 * dt * d for x, d in zip((h, w, u), k2)))[:3]
+        k4 = rates(*(x + dt * d for x, d in zip((h, w, u), k3)))[:3]
+        new = tuple(x + dt / 6.0 * (a + 2.0 * b + 2.0 * c + d) for x, a, b, c, d in zip((h, w, u), k1, k2, k3, k4))
         crossing = ~crossed & (new[1] <= 0.0)
         # w falls nearly linearly inside the step: the time to w = 0 and the height gained, h' = w, to it
-        tau = dt * state[1] / jnp.where(crossing, state[1] - new[1], 1.0)
-        apogee = jnp.where(crossing, state[0] + 0.5 * state[1] * tau, apogee)
+        tau = dt * w / jnp.where(crossing, w - new[1], 1.0)
+        apogee = jnp.where(crossing, h + 0.5 * w * tau, apogee)
         return (new, apogee, crossed | crossing), None
 
-    start = jnp.stack([height_m, w0, horizontal_mps + 0.0 * height_m])
-    (end, apogee, crossed), _ = jax.lax.scan(rk4, (start, height_m + 0.0, jnp.asarray(False)), None,
-                                             params.prediction_steps)  # fmt: skip
-    return jnp.where(climbing, jnp.where(crossed, apogee, end[0]), height_m)
+    start = (height_m + 0.0 * u0, w0, u0)
+    ((h_end, w_end, _), apogee, crossed), _ = jax.lax.scan(rk4, (start, height_m + 0.0 * u0, jnp.asarray(False)), None,
+                                                           params.prediction_steps)  # fmt: skip
+    return jnp.where(climbing, jnp.where(crossed, apogee, h_end + w_end * w_end / (2.0 * G0)), height_m)
 
 
 def airbrake_step(params: AirbrakeParams, state: AirbrakeState, nav: Navigation, moving, t, dt,
