@@ -129,3 +129,22 @@ def test_a_schedule_and_flown_brakes_are_refused(tmp_path, capsys):
 
 def test_design_without_airbrakes(capsys):
     one_line(capsys, ["airbrakes", "design", str(CAMPAIGNS / "lynx_ballistic.toml")], "no [airbrakes] section")
+
+
+def test_brakes_on_the_navigation_alone():
+    """gnc.canards = false: the filters run and the brakes read them, no canard controller and none of its outputs."""
+    campaign = with_overrides(load_campaign(CAMPAIGNS / "lynx_euroc_airbrakes_gnc.toml"), n_realizations=4)
+    assert campaign.gnc_schedule is None  # nothing designed for canards the rocket has not
+    flown = fly(campaign)
+    assert np.all(flown["status"] == 0)
+    assert "control_active_time_s" not in flown and "position_error_apogee_m" in flown
+    assert np.all(flown["position_error_apogee_m"] > 0.0)  # the estimate is not the truth
+    assert np.all(np.abs(flown["apogee_error_m"]) < 300.0) and np.all(flown["airbrake_deployment_time_s"] > 0.0)
+
+
+def test_canard_faults_need_canards(tmp_path, capsys):
+    path = tmp_path / "no_canards.toml"
+    path.write_text(f'extends = "{CAMPAIGNS / "lynx_euroc_airbrakes_gnc.toml"}"\n'
+                    '[faults.stuck_canard]\nprobability = 0.5\ntime_s = [1.0, 2.0]\n')  # fmt: skip
+    one_line(capsys, ["run", str(path), "--out", str(tmp_path / "out.h5")], "faults.stuck_canard", "gnc.canards is false")
+    assert not (tmp_path / "out.h5").exists()
