@@ -24,7 +24,7 @@ import jax.numpy as jnp
 
 from ..dynamics.servo import ServoParams, ServoState, hold_command
 from ..env.atmosphere import G0, isa
-from ..math import safe_sqrt
+from ..math import rk4_step, safe_sqrt
 from ..math.table import Table, interpolate
 from ..pytree import pytree_dataclass, static_field
 from .guidance import Navigation
@@ -114,13 +114,9 @@ def predicted_apogee_m(params: AirbrakeParams, height_m, climb_mps, horizontal_m
     coast = jnp.where(root > 0.0, jnp.arctan(w0 * root / G0) / jnp.where(root > 0.0, root, 1.0), w0 / G0)
     dt = jnp.minimum(HORIZON_MARGIN * coast, w0 / G0) / params.prediction_steps
 
-    def rk4(carry, _):
+    def step(carry, _):
         (h, w, u), apogee, crossed = carry
-        k1 = rates(h, w, u)[:3]
-        k2 = rates(*(x + 0.5 * dt * d for x, d in zip((h, w, u), k1)))[:3]
-        k3 = rates(*(x + 0.5 * dt * d for x, d in zip((h, w, u), k2)))[:3]
-        k4 = rates(*(x + dt * d for x, d in zip((h, w, u), k3)))[:3]
-        new = tuple(x + dt / 6.0 * (a + 2.0 * b + 2.0 * c + d) for x, a, b, c, d in zip((h, w, u), k1, k2, k3, k4))
+        new, _ = rk4_step(lambda _, y: (rates(*y)[:3], None), 0.0, (h, w, u), dt)
         crossing = ~crossed & (new[1] <= 0.0)
         # w falls nearly linearly inside the step: the time to w = 0 and the height gained, h' = w, to it
         tau = dt * w / jnp.where(crossing, w - new[1], 1.0)
@@ -128,7 +124,7 @@ def predicted_apogee_m(params: AirbrakeParams, height_m, climb_mps, horizontal_m
         return (new, apogee, crossed | crossing), None
 
     start = (height_m + 0.0 * u0, w0, u0)
-    ((h_end, w_end, _), apogee, crossed), _ = jax.lax.scan(rk4, (start, height_m + 0.0 * u0, jnp.asarray(False)), None,
+    ((h_end, w_end, _), apogee, crossed), _ = jax.lax.scan(step, (start, height_m + 0.0 * u0, jnp.asarray(False)), None,
                                                            params.prediction_steps)  # fmt: skip
     return jnp.where(climbing, jnp.where(crossed, apogee, h_end + w_end * w_end / (2.0 * G0)), height_m)
 
