@@ -1,8 +1,10 @@
 """The apogee against the air brakes' target: brakes off, on the true state, on the flight software's navigation, and
-that navigation with a drag the software does not know or a noisier barometer; realizations paired (same seed and
-draws), the RMS error's ratio to the brakes off with a paired bootstrap interval.
+that navigation with a drag the software does not know or a noisier barometer; each on the campaign's law and, for a
+campaign flying the apogee prediction, on the reference-trajectory PI too; realizations paired (same seed and draws),
+the RMS error's ratio to the brakes off with a paired bootstrap interval.
 
     python benchmarks/airbrakes.py [--campaign campaigns/lynx_euroc_airbrakes.toml] [--n 10000] [--gnc-n 2000]
+                                   [--only CASE,...]
 
 The navigation cases fly ``campaigns/<name>_gnc.toml`` when it exists (the campaign's brakes on the MEKF and the
 Kalman filter over realistic sensors), else they are left out. Writes nothing; prints one line per case and a JSON
@@ -31,14 +33,21 @@ def fly(campaign) -> dict:
             if k in chunks[0].outputs}  # fmt: skip
 
 
+PI = {"airbrakes.controller": "reference_pi"}
+
+
 def cases(path: Path, n: int, gnc_n: int) -> dict:
     base = load_campaign(path)
+    other = base.config.airbrakes.controller == "prediction"
     runs = {"off": with_overrides(base, n_realizations=n, airbrakes=False), "truth": with_overrides(base, n_realizations=n)}
+    runs |= {"truth, reference-trajectory PI": with_overrides(base, n_realizations=n, values=PI)} if other else {}
     gnc_path = path.with_name(f"{path.stem}_gnc.toml")
     if gnc_path.exists():
         gnc = with_overrides(load_campaign(gnc_path), n_realizations=gnc_n)
-        runs |= {"off (N of the navigation cases)": with_overrides(base, n_realizations=gnc_n, airbrakes=False),
-                 "navigation": gnc,
+        if gnc_n != n:
+            runs["off (N of the navigation cases)"] = with_overrides(base, n_realizations=gnc_n, airbrakes=False)
+        runs |= {"navigation": gnc,
+                 **({"navigation, reference-trajectory PI": with_overrides(gnc, values=PI)} if other else {}),
                  "navigation, drag +10 % unknown": with_overrides(gnc, values={"dispersions.rocket.aero.drag_scale": UNKNOWN_DRAG}),
                  "navigation, barometer noise 12 Pa": with_overrides(gnc, values={"avionics.barometer.noise_std": 12.0}),
                  "navigation, barometer noise 60 Pa": with_overrides(gnc, values={"avionics.barometer.noise_std": 60.0})}  # fmt: skip
@@ -50,11 +59,15 @@ def main() -> None:
     parser.add_argument("--campaign", default="campaigns/lynx_euroc_airbrakes.toml")
     parser.add_argument("--n", type=int, default=10_000)
     parser.add_argument("--gnc-n", type=int, default=2_000)
+    parser.add_argument("--only", help="these cases (comma-separated names as printed) and their brakes-off baseline")
     args = parser.parse_args()
     path = Path(args.campaign)
     target = load_campaign(path).config.airbrakes.target_apogee_m
     flown, report = {}, {"campaign": path.stem, "target_m": target}
+    only = None if args.only is None else set(args.only.split(","))
     for name, campaign in cases(path, args.n, args.gnc_n).items():
+        if only is not None and not name.startswith("off") and name not in only:
+            continue
         out = flown[name] = fly(campaign)
         ok = out["status"] == 0
         error = out["apogee_agl_m"] - target

@@ -197,34 +197,41 @@ def _tune(args) -> int:
     out = _output_file("--out", args.out, (".toml",))
     if out.exists() and not args.force:
         raise RocketmcError(f"--out {out}: exists (--force replaces it)")
-    if args.objective == "apogee_error" and args.apogee_target_m is None:
-        raise RocketmcError("--apogee-target-m: needed by --objective apogee_error")
     campaign = _campaign(args.campaign, **_switched(args))
+    target = args.apogee_target_m
+    if args.objective == "apogee_error" and target is None:
+        if campaign.config.airbrakes is None:
+            raise RocketmcError("--apogee-target-m: needed by --objective apogee_error (no [airbrakes] target to take)")
+        target = campaign.config.airbrakes.target_apogee_m
     given = [item.strip().partition("=") for item in args.params.split(",") if item.strip()]
     paths = [path.strip() for path, _, _ in given]
     starts = {path.strip(): _number(f"--params {path.strip()}", start) for path, _, start in given if start}
     if "gnc.guidance.wind_gain" in paths and "gnc.guidance.wind_gain" not in campaign.nominal:
         starts.setdefault("gnc.guidance.wind_gain", 1.0)  # off unless set: from the wind itself moving the reference
+    brakes = campaign.config.airbrakes
+    if brakes is not None and brakes.reference is None and any(path.startswith("airbrakes.reference.") for path in starts):
+        starts = {"airbrakes.reference": {}, **starts}  # the section the defaults were taken from, to set a start in
     try:
-        campaign = with_overrides(campaign, values=starts) if starts and campaign.config.gnc is not None else campaign
+        campaign = with_overrides(campaign, values=starts) if starts else campaign
         check_parameters(campaign, paths)
     except ConfigError as e:
         raise RocketmcError(f"{args.campaign}: {e}") from None
+    brakes_only = all(path.startswith("airbrakes.") for path in paths)
     progress = _progress(args.quiet)
     try:
         tuning = tune(campaign, paths, args.objective, args.train, args.steps, args.learning_rate,
-                      args.apogee_target_m, args.train_turbulence, progress)  # fmt: skip
+                      target, args.train_turbulence, progress)  # fmt: skip
         values = rounded(tuning.tuned)
         calm = "" if args.train_turbulence else " without turbulence"
-        comment = (f"Guidance tuned by `rocketmc tune` ({args.objective}, {args.train} training flights{calm} of seed "
+        comment = (f"Tuned by `rocketmc tune` ({args.objective}, {args.train} training flights{calm} of seed "
                    f"{campaign.config.seed + TRAINING_SEED_OFFSET}, {args.steps} Adam steps of {args.learning_rate:g}, "
                    f"the lowest training objective at step {tuning.best}) from {Path(args.campaign).name}.")  # fmt: skip
         out.write_text(tuned_campaign_text(campaign, Path(args.campaign), out, values, comment))
         tuned = _campaign(str(out), **_switched(args))
         held_out = {}
         if args.test:
-            target = args.apogee_target_m
-            runs = {"controller off": with_overrides(campaign, controller=False), "start": campaign, "tuned": tuned}
+            off = with_overrides(campaign, airbrakes=False) if brakes_only else with_overrides(campaign, controller=False)
+            runs = {"controller off": off, "start": campaign, "tuned": tuned}
             for label, run in runs.items():
                 progress(f"held out: {args.test} flights of seed {campaign.config.seed}, {label}")
                 held_out[label] = evaluate(run, args.objective, args.test, target)
@@ -363,7 +370,8 @@ def _airbrakes_design(args) -> int:
     if campaign.airbrake_design is None:
         raise RocketmcError(f"{args.campaign}: no [airbrakes] section, so no air brakes to design")
     design = campaign.airbrake_design
-    print(json.dumps(design._asdict(), indent=2) if args.json else format_design(design))
+    numbers = {name: None if isinstance(value, float) and math.isnan(value) else value for name, value in design._asdict().items()}
+    print(json.dumps(numbers, indent=2, allow_nan=False) if args.json else format_design(design))
     return 0
 
 
@@ -704,17 +712,20 @@ def build_parser() -> argparse.ArgumentParser:
     replace.add_argument("--force", action="store_true", help="replace an existing result file")
     replace.add_argument("--resume", action="store_true", help="complete the partial run left in OUT.partial/")
     _flight_switches(sensitivity)
-    tuner = commands.add_parser("tune", help="tune the controller's guidance numbers by gradient descent through a "
-                                             "batch of training flights, and write the tuned campaign")  # fmt: skip
-    tuner.add_argument("campaign", help="campaign file (TOML) with a [gnc] section")
+    tuner = commands.add_parser("tune", help="tune the controller's guidance numbers or the air brakes' gains by "
+                                             "gradient descent through a batch of training flights, and write the "
+                                             "tuned campaign")  # fmt: skip
+    tuner.add_argument("campaign", help="campaign file (TOML) with a [gnc] or an [airbrakes] section")
     tuner.add_argument("--params", required=True, metavar="PATH[=START],...",
-                       help="guidance numbers to tune, each from the campaign's value or from START, e.g. "
+                       help="numbers to tune, each from the campaign's value or from START, e.g. "
                             "gnc.guidance.gain,gnc.guidance.wind_gain=4 (the upwind aim, off unless set, from 1 "
-                            "without START); a gradient finds the nearest minimum: start where a coarse scan is lowest")  # fmt: skip
+                            "without START) or airbrakes.reference.kp_n_s_per_m,airbrakes.reference.ki_n_per_m; a "
+                            "gradient finds the nearest minimum: start where a coarse scan is lowest")  # fmt: skip
     tuner.add_argument("--objective", choices=("ellipse_area", "apogee_error"), default="ellipse_area",
                        help="the 95 %% landing ellipse's area, or the apogee's RMS error to --apogee-target-m")
     tuner.add_argument("--apogee-target-m", type=_bounded(float, 0.0, MAX_ALTITUDE_M, "a height above the pad", above=True),
-                       help="the target of --objective apogee_error [m above the pad]")  # fmt: skip
+                       help="the target of --objective apogee_error [m above the pad] (default: [airbrakes]' "
+                            "target_apogee_m)")  # fmt: skip
     tuner.add_argument("--train", type=COUNT, default=256, help="training flights (default 256; the campaign's seed + 1)")
     tuner.add_argument("--test", type=_bounded(int, 0, None, "0 or more"), default=1000,
                        help="held-out flights (the campaign's own seed) flown before and after, and with the "

@@ -4,8 +4,8 @@ so that no draw, stream or set-up of the error sources can differ between chunks
 ``every_error_source`` edits a shipped full-GNC campaign's tables (lynx_nominal_gnc_1s, lynx_ballistic_gnc_1s): the
 truth in the IGRF-14 with a dispersed anomaly while the MEKF carries the dipole, the calibrated datasheet parts
 (BMX160, MS5803-01BA, NEO-M9N) with their per-flight spreads, hard- and soft-iron spreads, canard position sensors
-with errors, the filters initialised on the pad, the guidance reference derived at set-up, and every fault at
-probability 0.5."""
+with errors, the filters initialised on the pad, the guidance reference derived at set-up, air brakes flown on the
+navigation by the reference-trajectory PI to a target below the nominal apogee, and every fault at probability 0.5."""
 
 from __future__ import annotations
 
@@ -50,7 +50,11 @@ probability = 0.5
 time_s = [1.0, 8.0]
 magnitude_mps2 = 0.5
 """
-"""Every fault; the magnetometer's step may come on the pad, during the filters' pad samples (0 to 0.4 s)."""
+"""Every fault of a rocket with canards and sensors; the magnetometer's step may come on the pad, during the filters'
+pad samples (0 to 0.4 s)."""
+AIRBRAKE_FAULT = {"stuck_airbrakes": {"probability": 0.5, "time_s": [5.0, 12.0]}}
+"""The air brakes' fault, frozen where they are, for a campaign with them (``every_error_source``)."""
+EVERY_FAULT_KIND = (*FAULT_KINDS, "stuck_airbrakes")
 
 CALIBRATED_PARTS = {
     "part": "bmx160", "accelerometer": {"cross_axis_std": 0.002},
@@ -59,6 +63,9 @@ CALIBRATED_PARTS = {
     "canard_feedback": {"lsb": 0.1, "noise_std": 0.05, "bias_std": [0.2, 0.2, 0.2, 0.2], "scale_factor_std": 0.01},
 }  # fmt: skip
 """The calibrated datasheet parts with hard- and soft-iron spreads and canard position sensors with errors."""
+AIRBRAKES = {"target_apogee_m": 1500.0, "controller": "reference_pi", "max_mach": 0.85,
+             "panels": {"count": 3, "width_m": 0.082, "max_extension_m": 0.030}}  # fmt: skip
+"""Air brakes (lynx_euroc_airbrakes.toml's panels) on the navigation, Skyward's law, 100 m below the nominal apogee."""
 
 
 def every_error_source(tables: dict) -> dict:
@@ -79,7 +86,9 @@ def every_error_source(tables: dict) -> dict:
     tables["gnc"]["filters"].update({"initialisation": "pad", "pad_samples": 20})
     assert tables["avionics"] == {"part": "thesis"}
     tables["avionics"] = copy.deepcopy(CALIBRATED_PARTS)
-    tables["faults"] = tomllib.loads(FAULTS)["faults"]
+    assert "airbrakes" not in tables
+    tables["airbrakes"] = copy.deepcopy(AIRBRAKES)
+    tables["faults"] = tomllib.loads(FAULTS)["faults"] | copy.deepcopy(AIRBRAKE_FAULT)
     return tables
 
 
@@ -92,7 +101,7 @@ def write_every_error_source(base: Path, folder: Path) -> Path:
     assert config.gnc.filters.initialisation == "pad" and config.gnc.guidance.apogee_m is None
     assert (config.avionics.part, config.avionics.barometer.part, config.avionics.gnss.part) == (
         "bmx160", "ms5803_01ba", "neo_m9n")  # fmt: skip
-    assert set(config.faults.active()) == set(FAULT_KINDS)
+    assert set(config.faults.active()) == set(EVERY_FAULT_KIND) and config.airbrakes.controller == "reference_pi"
     spreads = {"environment.magnetic_field.anomaly_nt.0", "avionics.magnetometer.soft_iron.1",
                "avionics.magnetometer.hard_iron.2", "avionics.gyroscope.bias.0", "avionics.barometer.bias.0",
                "avionics.canard_feedback.bias.3", "avionics.accelerometer.cross_axis.5"}  # fmt: skip
@@ -105,9 +114,10 @@ def write_every_error_source(base: Path, folder: Path) -> Path:
 def assert_every_fault_recorded(data: dict, n: int) -> None:
     """``data`` (a result file's ``"inputs/<name>"`` arrays, ``test_resume.contents``) records every fault, which
     some but not all of the ``n`` flights had, and the per-flight draws of the iron and the anomaly."""
-    for kind in FAULT_KINDS:
+    for kind in EVERY_FAULT_KIND:
         happened = data[f"inputs/faults.{kind}.happened"]
         assert happened.shape == (n,) and 0 < np.sum(happened == 1.0) < n, kind
     for name in ("environment.magnetic_field.anomaly_nt.0", "avionics.magnetometer.soft_iron.1",
                  "avionics.canard_feedback.bias.3"):  # fmt: skip
         assert len(np.unique(data[f"inputs/{name}"])) == n, name
+    assert np.any(data["outputs/airbrake_deployment_time_s"] > 0.0)  # the brakes flew

@@ -3,6 +3,8 @@ changing nothing, the same flights whatever the chunking, and their bad input.""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -45,6 +47,31 @@ def test_brakes_bring_the_apogee_toward_the_target(euroc):
     assert np.all(np.abs(on["apogee_error_m"]) < np.abs(off["apogee_agl_m"] - target))
     assert np.array_equal(on["apogee_error_m"], on["apogee_agl_m"] - target)
     assert np.all(on["airbrake_active_time_s"] > 0.0) and np.all(on["airbrake_deployment_time_s"] > 0.0)
+
+
+def test_the_reference_pi_is_designed_for_its_second_order_response():
+    campaign = load_campaign(CAMPAIGNS / "lynx_euroc_airbrakes_pi.toml")
+    d, r, pi = campaign.airbrake_design, campaign.airbrakes.reference, campaign.config.airbrakes.reference_pi
+    mass = float(campaign.airbrakes.coast_mass_kg)
+    assert d.controller == "reference_pi" and d.references == len(pi.levels) == r.climb_mps.shape[0]
+    assert float(r.kp_n_s_per_m) == pytest.approx(2.0 * pi.damping * pi.natural_frequency_rad_s * mass, rel=1e-15)
+    assert float(r.ki_n_per_m) == pytest.approx(pi.natural_frequency_rad_s**2 * mass, rel=1e-15)
+    # the more the brakes are held out, the faster the coast that still ends at the target: references never cross
+    assert np.all(np.diff(np.asarray(r.climb_mps)[:, :-1], axis=0) > 0.0)
+    given = with_overrides(campaign, values={"airbrakes.reference": {"kp_n_s_per_m": 55.0, "ki_n_per_m": 50.0}})
+    assert (float(given.airbrakes.reference.kp_n_s_per_m), float(given.airbrakes.reference.ki_n_per_m)) == (55.0, 50.0)
+    assert not given.airbrake_design.gain_designed
+
+
+def test_the_reference_pi_brings_the_apogee_to_the_target(euroc):
+    pi = fly(with_overrides(load_campaign(CAMPAIGNS / "lynx_euroc_airbrakes_pi.toml"), n_realizations=8))
+    assert np.all(pi["status"] == 0)
+    error = pi["apogee_error_m"]
+    # on the truth, the flights the brakes can reach land within a metre (N = 200: median +0.1 m, 5th percentile
+    # −0.4 m); the others are those the brakes cannot slow enough, fully out (saturated) to the end
+    reached = pi["airbrake_saturated_fraction"] < 0.9
+    assert reached.sum() >= 4 and np.all(np.abs(error[reached]) < 3.0)
+    assert np.all(error[~reached] > 0.0)
 
 
 def test_brakes_that_never_open_change_no_bit(euroc):
@@ -93,6 +120,9 @@ def test_airbrakes_design_command(capsys):
     assert main(["airbrakes", "design", str(EUROC)]) == 0
     out = capsys.readouterr().out
     assert "target apogee 3000 m above the pad: within reach" in out and "integral gain K_i" in out
+    assert main(["airbrakes", "design", str(CAMPAIGNS / "lynx_euroc_airbrakes_pi.toml"), "--json"]) == 0
+    design = json.loads(capsys.readouterr().out)  # strict JSON: the other law's numbers are null
+    assert design["controller"] == "reference_pi" and design["gain_per_m_s"] is None and design["references"] == 9
 
 
 BRAKES = """
@@ -111,6 +141,16 @@ target_apogee_m = 3000.0
      "delta_ca needs 3 rows"),
     (BRAKES + "[airbrakes.servo]\ntime_constant_s = -0.1\n[airbrakes.panels]\ncount = 3\nwidth_m = 0.05\nmax_extension_m = 0.02\n",
      "airbrakes.servo.time_constant_s"),
+    (BRAKES + "[airbrakes.reference]\n[airbrakes.panels]\ncount = 3\nwidth_m = 0.05\nmax_extension_m = 0.02\n",
+     "reference: read only by controller = 'reference_pi'"),
+    (BRAKES + "controller = 'reference_pi'\ngain_per_m_s = 0.01\n[airbrakes.panels]\ncount = 3\nwidth_m = 0.05\n"
+     "max_extension_m = 0.02\n", "gain_per_m_s: the prediction law's gain"),
+    (BRAKES + "controller = 'reference_pi'\n[airbrakes.reference]\nlevels = [0.5, 0.2]\n[airbrakes.panels]\ncount = 3\n"
+     "width_m = 0.05\nmax_extension_m = 0.02\n", "levels must be strictly increasing"),
+    (BRAKES + "controller = 'reference_pi'\n[airbrakes.reference]\nki_n_per_m = -1.0\n[airbrakes.panels]\ncount = 3\n"
+     "width_m = 0.05\nmax_extension_m = 0.02\n", "airbrakes.reference.ki_n_per_m"),
+    (BRAKES + "controller = 'pid'\n[airbrakes.panels]\ncount = 3\nwidth_m = 0.05\nmax_extension_m = 0.02\n",
+     "airbrakes.controller"),
 ])  # fmt: skip
 def test_bad_airbrakes_are_one_line(tmp_path, capsys, section, needle):
     path = tmp_path / "brakes.toml"

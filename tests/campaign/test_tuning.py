@@ -1,5 +1,6 @@
-"""``rocketmc tune``: the ranges it keeps the guidance in (the schema's), its objectives against closed forms, the
-tuned campaign file it writes, the command on a real closed loop and its bad input."""
+"""``rocketmc tune``: the ranges it keeps the guidance and the air brakes' gains in (the schema's), its objectives
+against closed forms, the tuned campaign file it writes, the command on a real closed loop, the brakes' gradient
+against finite differences, and its bad input."""
 
 from __future__ import annotations
 
@@ -9,9 +10,14 @@ import numpy as np
 import pydantic
 import pytest
 
+import jax
+import jax.numpy as jnp
+
 from rocketmc.campaign import load_campaign
-from rocketmc.campaign.model import GUIDANCE_NUMBERS
-from rocketmc.campaign.schema import GuidanceConfig
+from rocketmc.campaign.derivatives import DIFFERENTIATED_OUTPUTS, batch_function, jacobians
+from rocketmc.campaign.model import AIRBRAKE_NUMBERS, GUIDANCE_NUMBERS
+from rocketmc.campaign.runner import sim_settings
+from rocketmc.campaign.schema import AirbrakeReferenceConfig, AirbrakesControlConfig, GuidanceConfig
 from rocketmc.campaign.tuning import bounds, calm, objective_value, tuned_campaign_text
 from rocketmc.cli import main
 
@@ -40,6 +46,19 @@ def test_bounds_are_the_schemas_ranges(path):
         if np.isfinite(outside):
             with pytest.raises(pydantic.ValidationError):
                 _guidance(path, outside)
+
+
+@pytest.mark.parametrize("path", AIRBRAKE_NUMBERS)
+def test_airbrake_bounds_are_the_schemas_ranges(path):
+    name = path.rpartition(".")[2]
+    section = AirbrakeReferenceConfig if path.startswith("airbrakes.reference.") else AirbrakesControlConfig
+    low, high = bounds(path)
+    assert low == 0.0 and np.isfinite(high)
+    for outside in (low - 1e-3, high * 1.001):
+        with pytest.raises(pydantic.ValidationError):
+            section.model_validate({name: outside}) if section is AirbrakeReferenceConfig else AirbrakesControlConfig(
+                target_apogee_m=3000.0, table={"deployments": [0, 1], "machs": [0, 1], "delta_ca": [[0, 0], [1, 1]]},
+                **{name: outside})  # fmt: skip
 
 
 def test_apogee_error_is_the_rms_over_the_ok_flights():
@@ -75,6 +94,37 @@ def test_tuned_campaign_file_is_its_source_with_the_tuned_numbers(tmp_path):
     assert changed["gnc"]["guidance"]["apogee_m"] == original["gnc"]["guidance"]["apogee_m"]
 
 
+def test_tuned_brakes_file_sets_their_section(tmp_path):
+    source = CAMPAIGNS / "lynx_euroc_airbrakes_pi.toml"
+    out = tmp_path / "tuned.toml"
+    values = {"airbrakes.reference.kp_n_s_per_m": 60.0, "airbrakes.reference.ki_n_per_m": 40.0}
+    out.write_text(tuned_campaign_text(load_campaign(source), source, out, values, "brakes"))
+    tuned = load_campaign(out)
+    assert (float(tuned.airbrakes.reference.kp_n_s_per_m), float(tuned.airbrakes.reference.ki_n_per_m)) == (60.0, 40.0)
+    assert tuned.config.airbrakes.target_apogee_m == 3000.0 and tuned.config.airbrakes.controller == "reference_pi"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("campaign, path", [("custom_rocket_airbrakes.toml", "airbrakes.gain_per_m_s"),
+                                            ("lynx_euroc_airbrakes_pi.toml", "airbrakes.reference.kp_n_s_per_m")])
+def test_brake_gain_gradient_against_central_differences(campaign, path):
+    """What ``tune`` descends: the apogee's derivative with respect to a brake gain by reverse mode through the
+    bounded flight, against central differences of the forward flights (step 10⁻⁴ of the gain)."""
+    campaign = calm(load_campaign(CAMPAIGNS / campaign))
+    settings, master = sim_settings(campaign), jax.random.key(campaign.config.seed)
+    indices = jnp.arange(3, dtype=jnp.uint32)
+    _, status, derivatives = jax.jit(lambda i: jacobians(campaign, settings, master, i, (path,)))(indices)
+    x0, f = batch_function(campaign, settings, master, indices, (path,))
+    h = 1e-4 * x0
+    apogee = DIFFERENTIATED_OUTPUTS.index("apogee_agl_m")
+    difference = (f(x0 + h)[0][:, apogee] - f(x0 - h)[0][:, apogee]) / (2 * h[:, 0])
+    assert np.all(np.asarray(status) == 0)
+    exact = np.asarray(derivatives)[:, apogee, 0]
+    # measured: within 1.3e-7 (custom rocket; one of its three flights holds the command at a stop: 0 both ways) and 5.2e-7
+    # (the PI) relative; the median allows one flight where a tick's clip or saturation would fall inside the step
+    assert np.median(np.abs(exact - np.asarray(difference)) / np.maximum(np.abs(np.asarray(difference)), 1e-9)) < 1e-5
+
+
 def test_tune_command(tmp_path, capsys):
     """Four training flights of the ballistic closed loop, one Adam step: the step lowers the training objective
     (a descent step of 1 % on a smooth objective), the tuned file flies."""
@@ -99,6 +149,10 @@ def test_tune_command(tmp_path, capsys):
     ("lynx_nominal_ctrl_1s.toml", ["--params", "gnc.guidance.gain", "--objective", "apogee_error"], "--apogee-target-m"),
     ("lynx_nominal_ctrl_1s.toml", ["--params", "gnc.guidance.gain=fast"], "--params gnc.guidance.gain"),
     ("lynx_nominal_ctrl_1s.toml", ["--params", "gnc.guidance.gain=-1"], "gnc.guidance.gain"),
+    ("lynx_euroc_airbrakes.toml", ["--params", "airbrakes.reference.kp_n_s_per_m"], "airbrakes.reference"),
+    ("lynx_euroc_airbrakes_pi.toml", ["--params", "airbrakes.gain_per_m_s"], "--params airbrakes.gain_per_m_s"),
+    ("lynx_euroc_airbrakes_pi.toml", ["--params", "airbrakes.reference.ki_n_per_m=-3"], "airbrakes.reference.ki_n_per_m"),
+    ("lynx_euroc_airbrakes_gnc.toml", ["--params", "gnc.guidance.gain"], "--params gnc.guidance.gain"),
 ])  # fmt: skip
 def test_tune_bad_input_is_one_line_and_exit_2(tmp_path, capsys, campaign, extra, field):
     out = tmp_path / "tuned.toml"

@@ -126,15 +126,21 @@ def plot_flight(record: FlightRecord, directory: str | Path) -> list[Path]:
 
 
 def _plot_airbrakes(record: FlightRecord, path: Path) -> Path:
-    """The air brakes to apogee: altitude, the software's predicted apogee and the target; deployment and command."""
+    """The air brakes to apogee: altitude, the software's predicted apogee and the target (the reference-trajectory PI:
+    the climb rate and the chosen reference's); deployment and command."""
     up, end = ascent(record), record.summary["apogee_time_s"]
     target = record.campaign.config.airbrakes.target_apogee_m
     fig = Figure(figsize=(9.0, 7.5))
     ax_height, ax_deployment = fig.subplots(2, 1, sharex=True)
-    ax_height.plot(up["time"], up["altitude"], color="tab:blue", label="altitude above the pad")
-    ax_height.plot(up["time"], up["predicted_apogee"], color="tab:orange", label="predicted apogee (while allowed)")
-    ax_height.axhline(target, color="black", linewidth=0.8, label=f"target {target:.0f} m")
-    ax_height.set_ylabel("height above the pad [m]")
+    if "reference_climb" in up:
+        ax_height.plot(up["time"], -up["v_down"], color="tab:blue", label="climb rate")
+        ax_height.plot(up["time"], up["reference_climb"], color="tab:orange", label=f"the chosen reference's, to {target:.0f} m")
+        ax_height.set_ylabel("climb rate [m/s]")
+    else:
+        ax_height.plot(up["time"], up["altitude"], color="tab:blue", label="altitude above the pad")
+        ax_height.plot(up["time"], up["predicted_apogee"], color="tab:orange", label="predicted apogee (while allowed)")
+        ax_height.axhline(target, color="black", linewidth=0.8, label=f"target {target:.0f} m")
+        ax_height.set_ylabel("height above the pad [m]")
     ax_deployment.plot(up["time"], up["airbrake_deployment"], color="tab:blue", label="deployment")
     ax_deployment.plot(up["time"], up["airbrake_command"], color="tab:orange", linewidth=0.8, label="command")
     ax_deployment.set_ylabel("deployment [0 … 1]")

@@ -22,7 +22,7 @@ from ..sim.flight import max_blocks, simulate_bounded, simulate_one
 from ..sim.params import FlightParams, SimSettings
 from .errors import ConfigError
 from .limits import fixed_reason
-from .model import GUIDANCE_NUMBERS, flight_params, with_guidance
+from .model import AIRBRAKE_NUMBERS, GUIDANCE_NUMBERS, airbrake_numbers, flight_params, with_airbrakes, with_guidance
 from .record import Campaign
 from .sampling import realization_key, sample_dispersions, sample_faults
 
@@ -33,19 +33,22 @@ DIFFERENTIATED_OUTPUTS = ("impact_north_m", "impact_east_m", "apogee_agl_m", "im
 def differentiable_inputs(campaign: Campaign) -> list[str]:
     """The paths derivatives can be taken with respect to: every number of ``Campaign.nominal`` the flight reads
     from its values (``limits.fixed_reason`` None), the dispersed ones first, then the guidance's numbers
-    (``model.GUIDANCE_NUMBERS``) of a campaign with a closed loop."""
+    (``model.GUIDANCE_NUMBERS``) of a campaign with a closed loop and the air brakes' gains (``model.airbrake_numbers``)."""
     dispersed = [path for path in campaign.config.dispersions if fixed_reason(path) is None]
     guidance = [path for path in GUIDANCE_NUMBERS if campaign.config.gnc is not None and path in campaign.nominal]
-    return dispersed + [path for path in campaign.nominal if path not in dispersed and fixed_reason(path) is None] + guidance
+    undispersed = [path for path in campaign.nominal if path not in dispersed and fixed_reason(path) is None]
+    return dispersed + undispersed + guidance + list(airbrake_numbers(campaign))
 
 
 def _flight_params(campaign: Campaign, values: Mapping, key, wrt: Sequence[str], x) -> FlightParams:
     """The flight of ``values`` with those of ``wrt`` set to ``x``: guidance numbers in its guidance
-    (``with_guidance``), the others among its values."""
+    (``with_guidance``), the air brakes' gains in its brakes (``with_airbrakes``), the others among its values."""
     given = dict(zip(wrt, x))
     params = flight_params(campaign, {**values, **given}, key)
     guidance = {path: value for path, value in given.items() if path in GUIDANCE_NUMBERS}
-    return with_guidance(params, guidance) if guidance else params
+    brakes = {path: value for path, value in given.items() if path in AIRBRAKE_NUMBERS}
+    params = with_guidance(params, guidance) if guidance else params
+    return with_airbrakes(params, brakes) if brakes else params
 
 
 def default_inputs(campaign: Campaign) -> list[str]:
@@ -81,9 +84,10 @@ def spread(dispersion: Mapping | None) -> float:
 
 
 def _values(campaign: Campaign, master_key, index) -> tuple[dict, jnp.ndarray]:
-    """Realization ``index``'s values (``Campaign.nominal`` with its draws) and key."""
+    """Realization ``index``'s values (``Campaign.nominal`` and the brakes' gains, with its draws) and key."""
     key = realization_key(master_key, index)
-    return {**campaign.nominal, **sample_dispersions(campaign, key), **sample_faults(campaign.config.faults, key)}, key
+    drawn = {**sample_dispersions(campaign, key), **sample_faults(campaign.config.faults, key)}
+    return {**campaign.nominal, **airbrake_numbers(campaign), **drawn}, key
 
 
 def _outputs(summary: dict) -> jnp.ndarray:

@@ -257,7 +257,14 @@ def _series(campaign: Campaign, states, samples, summary) -> tuple[pd.DataFrame,
                                           "(0 retracted, 1 fully out)")  # fmt: skip
         columns["airbrake_command"] = (brakes.servo.command_rad, "1", "air brakes' command held over the period before")
         columns["predicted_apogee"] = (brakes.predicted_apogee_m, "m", "the brakes' software's apogee prediction above the "
-                                       "pad at the period before's start (NaN while the brakes may not open)")  # fmt: skip
+                                       "pad at the period before's start (NaN while the brakes may not open or fly "
+                                       "the reference-trajectory PI)")  # fmt: skip
+        if brakes.reference is not None:
+            r, chosen = campaign.airbrakes.reference, np.asarray(brakes.reference.trajectory)
+            every = np.array([np.interp(-np.asarray(body.r_n.z), r.heights_m, climb) for climb in r.climb_mps])
+            along = np.take_along_axis(every, np.maximum(chosen, 0)[None], axis=0)[0]
+            columns["reference_climb"] = (np.where(chosen >= 0, along, np.nan), "m/s", "the chosen reference's climb rate "
+                                          "at the true height (NaN before the brakes' PI chose one)")  # fmt: skip
     if states.gnc is not None and campaign.config.gnc.canards:
         for i in range(samples["deflections"].shape[1]):
             columns[f"canard_{i + 1}"] = (deg(samples["deflections"][:, i]), "deg", f"canard {i + 1} deflection, offset included")

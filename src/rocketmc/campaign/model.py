@@ -321,6 +321,36 @@ def with_guidance(params: FlightParams, values: Mapping) -> FlightParams:
     return dataclasses.replace(params, gnc=dataclasses.replace(params.gnc, guidance=guidance))
 
 
+AIRBRAKE_NUMBERS = {
+    "airbrakes.gain_per_m_s": ("gain_per_m_s", "prediction"),
+    "airbrakes.reference.kp_n_s_per_m": ("kp_n_s_per_m", "reference_pi"),
+    "airbrakes.reference.ki_n_per_m": ("ki_n_per_m", "reference_pi"),
+}
+"""[airbrakes]' controller gains a flight can take as values (``with_airbrakes``): path -> (the field of
+``AirbrakeParams``, or of its ``ReferencePI`` for the reference-trajectory PI; the law that has it), in SI."""
+
+
+def airbrake_numbers(campaign: Campaign) -> dict[str, float]:
+    """The gains the campaign's air brakes fly (designed or given) by ``AIRBRAKE_NUMBERS``' path, those of its law; none
+    without brakes."""
+    brakes = campaign.airbrakes
+    if brakes is None:
+        return {}
+    law = campaign.config.airbrakes.controller
+    holder = brakes if brakes.reference is None else brakes.reference
+    return {path: float(getattr(holder, field)) for path, (field, of) in AIRBRAKE_NUMBERS.items() if of == law}
+
+
+def with_airbrakes(params: FlightParams, values: Mapping) -> FlightParams:
+    """``params`` with the brakes' gains of ``values`` (``airbrake_numbers``' paths -> values, traced or not) in place
+    of the campaign's: what ``rocketmc tune`` adjusts and ``sensitivities --wrt`` differentiates."""
+    brakes = params.airbrakes
+    changes = {AIRBRAKE_NUMBERS[path][0]: value for path, value in values.items()}
+    brakes = (dataclasses.replace(brakes, **changes) if brakes.reference is None else
+              dataclasses.replace(brakes, reference=dataclasses.replace(brakes.reference, **changes)))  # fmt: skip
+    return dataclasses.replace(params, airbrakes=brakes)
+
+
 def nominal_rail(campaign: Campaign) -> tuple[Quat, Vec3]:
     """What the avionics know of the launch: the campaign's nominal rail (its configured elevation and azimuth, not a
     realization's draw), its attitude (body → NED) and the nominal rocket's CG at rest on it [m, NED]."""

@@ -21,7 +21,7 @@ from .limits import DISPERSIBLE_SECTIONS, fixed_reason
 from .schema import CampaignConfig, SensorConfig
 
 UNITS = {
-    "_deg_s2": "deg/s²", "_deg_s": "deg/s", "_per_m_s": "1/(m·s)", "_per_s": "1/s", "_per_kpa": "unit/kPa", "_kgm2": "kg·m²", "_m2": "m²", "_mps2": "m/s²", "_mps": "m/s", "_kpa": "kPa", "_kg": "kg", "_deg": "deg",
+    "_deg_s2": "deg/s²", "_deg_s": "deg/s", "_rad_s": "rad/s", "_n_s_per_m": "N·s/m", "_n_per_m": "N/m", "_per_m_s": "1/(m·s)", "_per_s": "1/s", "_per_kpa": "unit/kPa", "_kgm2": "kg·m²", "_m2": "m²", "_mps2": "m/s²", "_mps": "m/s", "_kpa": "kPa", "_kg": "kg", "_deg": "deg",
     "_hz": "Hz", "_s2": "s²", "_s": "s", "_m": "m", "_pa": "Pa", "_nt": "nT", "_n": "N",
 }  # fmt: skip
 """Unit of a key from its name's suffix (the project's convention: the unit ends the name), the first that

@@ -19,8 +19,12 @@ from .errors import shown
 from .limits import (
     DEFAULT_ALTITUDES_M,
     DEFAULT_SPEEDS_MPS,
+    MAX_AIRBRAKE_DAMPING,
     MAX_AIRBRAKE_GAIN,
     MAX_AIRBRAKE_MACH,
+    MAX_AIRBRAKE_NATURAL_FREQUENCY_RAD_S,
+    MAX_AIRBRAKE_PI_GAIN,
+    MAX_AIRBRAKE_REFERENCES,
     MAX_AIRBRAKE_PANELS,
     MAX_AIRBRAKE_RATE_PER_S,
     MAX_ALTITUDE_M,
@@ -862,6 +866,27 @@ class AirbrakeServoConfig(_Strict):
                                            description="largest deployment rate [1/s] (none: no slew limit)")
 
 
+class AirbrakeReferenceConfig(_Strict):
+    """The reference-trajectory PI of Skyward's flight software (docs/airbrakes.md): reference coasts to the target
+    apogee with the brakes held at ``levels``, a PI on the climb rate's excess over the nearest one, its gains designed
+    for the vertical motion's second-order response (K_p = 2ζω·m, K_i = ω²·m on the coast mass m) unless given."""
+
+    levels: list[Annotated[float, Field(gt=0, lt=1)]] = Field(
+        [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9], min_length=2, max_length=MAX_AIRBRAKE_REFERENCES,
+        description="the deployments the reference coasts are computed with, increasing (Skyward's: 10 % … 90 %)")
+    natural_frequency_rad_s: float = Field(1.5, gt=0, le=MAX_AIRBRAKE_NATURAL_FREQUENCY_RAD_S,
+                                           description="ω [rad/s] of the designed response (Skyward's gains: ~1.5)")
+    damping: float = Field(0.8, gt=0, le=MAX_AIRBRAKE_DAMPING, description="ζ [-] of the designed response (Skyward's: ~0.8)")
+    kp_n_s_per_m: float | None = Field(None, ge=0, le=MAX_AIRBRAKE_PI_GAIN, description="K_p [N/(m/s)] (none: designed)")
+    ki_n_per_m: float | None = Field(None, ge=0, le=MAX_AIRBRAKE_PI_GAIN, description="K_i [N/m] (none: designed)")
+
+    @model_validator(mode="after")
+    def _increasing(self):
+        if np.any(np.diff(self.levels) <= 0):
+            raise ValueError(f"levels must be strictly increasing, got {self.levels}")
+        return self
+
+
 class AirbrakesControlConfig(_Strict):
     """Air brakes and the flight software that flies them to a target apogee (docs/airbrakes.md): the drag they add
     (``panels`` or ``table``), their servo, when they may open, and the controller: a ballistic prediction of the
@@ -880,12 +905,30 @@ class AirbrakesControlConfig(_Strict):
                                    description="the time constant the gain is designed for at the nominal window's start [s]")
     gain_per_m_s: float | None = Field(None, ge=0, le=MAX_AIRBRAKE_GAIN,
                                        description="K_i [1/(m·s)] (none: designed for response_time_s)")
+    controller: Literal["prediction", "reference_pi"] = _added(
+        "prediction", "the law: the apogee prediction with integral feedback, or Skyward's reference-trajectory PI")
+    reference: AirbrakeReferenceConfig | None = _added(
+        None, "the reference-trajectory PI's numbers (controller = 'reference_pi'; none: its defaults)")
 
     @model_validator(mode="after")
     def _one_drag(self):
         if (self.panels is None) == (self.table is None):
             raise ValueError("give the brakes' drag as exactly one of panels or table")
         return self
+
+    @model_validator(mode="after")
+    def _one_law(self):
+        if self.controller == "prediction" and self.reference is not None:
+            raise ValueError("reference: read only by controller = 'reference_pi' (this campaign flies 'prediction')")
+        if self.controller == "reference_pi" and self.gain_per_m_s is not None:
+            raise ValueError("gain_per_m_s: the prediction law's gain; controller = 'reference_pi' takes "
+                             "reference.kp_n_s_per_m and reference.ki_n_per_m")  # fmt: skip
+        return self
+
+    @property
+    def reference_pi(self) -> AirbrakeReferenceConfig | None:
+        """The reference-trajectory PI's numbers, its defaults if not given; None with the prediction law."""
+        return None if self.controller == "prediction" else self.reference or AirbrakeReferenceConfig()
 
 
 DEFAULT_PART = "thesis"

@@ -1,13 +1,15 @@
-"""The closed loop's guidance tuned by gradient descent through a Monte Carlo (``rocketmc tune``).
+"""The closed loop's guidance or the air brakes' gains tuned by gradient descent through a Monte Carlo
+(``rocketmc tune``).
 
 The objective is a statistic of a batch of training flights (``OBJECTIVES``): the 95 % landing ellipse's area, or
 the apogee's RMS error to a target. Each step flies the batch once forward and once backward (reverse mode through
 ``sim.flight.simulate_bounded``: ``derivatives.batch_function``) for the objective's gradient with respect to the
-guidance numbers tuned (``model.GUIDANCE_NUMBERS``), shared by every flight, and takes an Adam step (optax) on the
-numbers scaled by their starting values, projected back into the ranges the campaign schema allows. The training
-flights are drawn from another master seed than the campaign's (``TRAINING_SEED_OFFSET``), so that the campaign's
-own realizations, with which ``rocketmc run`` and ``compare`` pair it, stay held out; by default they fly without
-the campaign's turbulence (``calm``), whose gusts make a flight only piecewise continuous in the guidance's numbers.
+numbers tuned (``model.GUIDANCE_NUMBERS``, ``model.AIRBRAKE_NUMBERS``), shared by every flight, and takes an Adam
+step (optax) on the numbers scaled by their starting values, projected back into the ranges the campaign schema
+allows. The training flights are drawn from another master seed than the campaign's (``TRAINING_SEED_OFFSET``), so
+that the campaign's own realizations, with which ``rocketmc run`` and ``compare`` pair it, stay held out; by default
+they fly without the campaign's turbulence (``calm``), whose gusts make a flight only piecewise continuous in the
+numbers.
 """
 
 from __future__ import annotations
@@ -30,10 +32,14 @@ import optax
 from ..ellipse import chi2_scale
 from .derivatives import DIFFERENTIATED_OUTPUTS, batch_function, check_inputs, ellipse_area_m2
 from .errors import ConfigError
-from .model import GUIDANCE_NUMBERS
+from .model import GUIDANCE_NUMBERS, airbrake_numbers
 from .record import Campaign
 from .runner import sim_settings
-from .schema import GuidanceConfig
+from .schema import AirbrakeReferenceConfig, AirbrakesControlConfig, CampaignConfig, GuidanceConfig
+
+SECTIONS = {"gnc.guidance": GuidanceConfig, "airbrakes.reference": AirbrakeReferenceConfig,
+            "airbrakes": AirbrakesControlConfig}  # fmt: skip
+"""The sections whose numbers can be tuned, by path prefix (a section before those it is inside), and their schema."""
 
 OBJECTIVES = {"ellipse_area": "the 95 % landing ellipse's area [m²]", "apogee_error": "the apogee's RMS error to the target [m]"}
 TRAINING_SEED_OFFSET = 1
@@ -52,10 +58,19 @@ def objective_value(objective: str, outputs, status, apogee_target_m: float | No
     return jnp.sqrt((error**2).sum() / jnp.maximum(ok.sum(), 1).astype(error.dtype))
 
 
+def _section(path: str) -> tuple[str, str, str]:
+    """(section, field, index) of a tunable number's path (``SECTIONS``): "gnc.guidance.integrator_gain.0" ->
+    ("gnc.guidance", "integrator_gain", "0")."""
+    section = next(prefix for prefix in SECTIONS if path.startswith(prefix + "."))
+    name, _, index = path.removeprefix(section + ".").partition(".")
+    return section, name, index
+
+
 def bounds(path: str) -> tuple[float, float]:
-    """The range [low, high] the campaign schema allows a guidance number (``GUIDANCE_NUMBERS``' path) in; a strict
-    bound moved inside by 10⁻⁹ of its size."""
-    field = GuidanceConfig.model_fields[path.split(".")[2]]
+    """The range [low, high] the campaign schema allows a tunable number (``GUIDANCE_NUMBERS``' or
+    ``AIRBRAKE_NUMBERS``' path) in; a strict bound moved inside by 10⁻⁹ of its size."""
+    section, name, _ = _section(path)
+    field = SECTIONS[section].model_fields[name]
     constraints, pending = list(field.metadata), list(typing.get_args(field.annotation))
     while pending:  # the bounds of an Annotated type inside the field's annotation (Height | None, list[...])
         arg = pending.pop()
@@ -85,16 +100,24 @@ def calm(campaign: Campaign) -> Campaign:
     return with_overrides(campaign, values={**values, "environment.turbulence": None})
 
 
+def tunable(campaign: Campaign) -> list[str]:
+    """The numbers ``tune`` can adjust in ``campaign``: its canards' guidance numbers, its air brakes' gains."""
+    gnc = campaign.config.gnc
+    guidance = list(GUIDANCE_NUMBERS) if gnc is not None and gnc.canards else []
+    return guidance + list(airbrake_numbers(campaign))
+
+
 def check_parameters(campaign: Campaign, paths: Sequence[str]) -> None:
     """Raise ``ConfigError`` naming the first of ``paths`` that cannot be tuned: not a guidance number of this
-    campaign's closed loop."""
-    if campaign.config.gnc is None:
-        raise ConfigError("--params: the campaign has no [gnc] section (no controller to tune)")
+    campaign's closed loop, nor a gain of its air brakes' law."""
+    allowed = tunable(campaign)
+    if not allowed:
+        raise ConfigError("--params: the campaign has no canards ([gnc]) nor air brakes ([airbrakes]): no controller to tune")
     if not paths:
-        raise ConfigError("--params: name at least one guidance number (e.g. gnc.guidance.gain)")
+        raise ConfigError(f"--params: name at least one of {', '.join(allowed)}")
     for path in paths:
-        if path not in GUIDANCE_NUMBERS:
-            raise ConfigError(f"--params {path}: not a guidance number; tunable: {', '.join(GUIDANCE_NUMBERS)}")
+        if path not in allowed:
+            raise ConfigError(f"--params {path}: not a tunable number of this campaign; tunable: {', '.join(allowed)}")
     check_inputs(campaign, paths)
 
 
@@ -152,7 +175,7 @@ def tune(campaign: Campaign, paths: Sequence[str], objective: str, train: int, s
         (value, failed), grad = gradient(theta)
         for name, item in zip(history, (np.asarray(theta) * scale, float(value), int(failed), time.perf_counter() - t0)):
             history[name].append(item)
-        shown = ", ".join(f"{path.removeprefix('gnc.guidance.')} {v:.4g}" for path, v in zip(paths, history["values"][-1]))
+        shown = ", ".join(f"{_section(path)[1]} {v:.4g}" for path, v in zip(paths, history["values"][-1]))
         progress(f"step {step}/{steps}: {objective} {float(value):.6g} ({int(failed)} failed) at {shown}", True)
         if step == steps or not np.all(np.isfinite(np.asarray(grad))):
             break
@@ -172,24 +195,30 @@ def rounded(values: dict[str, float], digits: int = 4) -> dict[str, float]:
     return {path: float(f"{v:.{digits}g}") for path, v in values.items()}
 
 
+def _config_section(config: CampaignConfig, section: str):
+    return {"gnc.guidance": lambda: config.gnc.guidance, "airbrakes": lambda: config.airbrakes,
+            "airbrakes.reference": lambda: config.airbrakes.reference_pi}[section]()  # fmt: skip
+
+
 def tuned_campaign_text(campaign: Campaign, source: Path, out: Path, values: dict[str, float], comment: str) -> str:
-    """A campaign file at ``out``, named as the file, that extends ``source`` (``campaign``'s file) with the guidance
-    numbers ``values`` (``GUIDANCE_NUMBERS``' paths) in its [gnc.guidance], ``comment`` on top."""
-    guidance = campaign.config.gnc.guidance
-    table: dict[str, object] = {}
+    """A campaign file at ``out``, named as the file, that extends ``source`` (``campaign``'s file) with the tuned
+    numbers ``values`` (``tunable``'s paths) in their sections, ``comment`` on top."""
+    tables: dict[str, dict[str, object]] = {}
     for path, value in values.items():
-        name, _, index = path.removeprefix("gnc.guidance.").partition(".")
+        section, name, index = _section(path)
+        table = tables.setdefault(section, {})
         if index:
-            vector = table.setdefault(name, list(getattr(guidance, name)))
+            vector = table.setdefault(name, list(getattr(_config_section(campaign.config, section), name)))
             vector[int(index)] = value
         else:
             table[name] = value
     extends = Path(os.path.relpath(source.resolve(), out.resolve().parent)).as_posix()
     name = out.stem
     lines = [f"# {line}".rstrip() for line in comment.splitlines()]
-    description = f"{campaign.config.description}; guidance tuned by gradient ({', '.join(values)})"
-    lines += [f"extends = {json.dumps(extends)}", f"name = {json.dumps(name)}", f"description = {json.dumps(description)}", "",
-              "[gnc.guidance]", *(f"{key} = {_toml_value(value)}" for key, value in table.items())]  # fmt: skip
+    description = f"{campaign.config.description}; tuned by gradient ({', '.join(values)})"
+    lines += [f"extends = {json.dumps(extends)}", f"name = {json.dumps(name)}", f"description = {json.dumps(description)}"]
+    for section, table in tables.items():
+        lines += ["", f"[{section}]", *(f"{key} = {_toml_value(value)}" for key, value in table.items())]
     return "\n".join(lines) + "\n"
 
 

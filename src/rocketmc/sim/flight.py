@@ -49,7 +49,7 @@ def initial_state(p: FlightParams) -> FlightState:
     filters = None if turbulence is None else initial_turbulence(turbulence)
     gnc = None if p.gnc is None else initial_gnc(p.gnc, zero)
     avionics = None if p.avionics is None else initial_avionics(p.avionics, zero)
-    airbrakes = None if p.airbrakes is None else initial_airbrakes(zero)
+    airbrakes = None if p.airbrakes is None else initial_airbrakes(p.airbrakes, zero)
     return FlightState(zero, jnp.zeros_like(zero, dtype=jnp.int32), body, events, Canopy(zero, zero), filters, gnc,
                        avionics, airbrakes)  # fmt: skip
 
