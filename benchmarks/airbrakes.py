@@ -4,7 +4,7 @@ campaign flying the apogee prediction, on the reference-trajectory PI too; reali
 the RMS error's ratio to the brakes off with a paired bootstrap interval.
 
     python benchmarks/airbrakes.py [--campaign campaigns/lynx_euroc_airbrakes.toml] [--n 10000] [--gnc-n 2000]
-                                   [--only CASE,...]
+                                   [--only CASE ...]
 
 The navigation cases fly ``campaigns/<name>_gnc.toml`` when it exists (the campaign's brakes on the MEKF and the
 Kalman filter over realistic sensors), else they are left out. Writes nothing; prints one line per case and a JSON
@@ -59,12 +59,13 @@ def main() -> None:
     parser.add_argument("--campaign", default="campaigns/lynx_euroc_airbrakes.toml")
     parser.add_argument("--n", type=int, default=10_000)
     parser.add_argument("--gnc-n", type=int, default=2_000)
-    parser.add_argument("--only", help="these cases (comma-separated names as printed) and their brakes-off baseline")
+    parser.add_argument("--only", action="append", metavar="CASE",
+                        help="this case (its name as printed; repeat for more) and its brakes-off baseline")
     args = parser.parse_args()
     path = Path(args.campaign)
     target = load_campaign(path).config.airbrakes.target_apogee_m
     flown, report = {}, {"campaign": path.stem, "target_m": target}
-    only = None if args.only is None else set(args.only.split(","))
+    only = None if args.only is None else set(args.only)
     for name, campaign in cases(path, args.n, args.gnc_n).items():
         if only is not None and not name.startswith("off") and name not in only:
             continue
